@@ -1,0 +1,113 @@
+#pragma once
+// Settings as plain Params structs (defaults in place, units in comments, one validate() that
+// names the bad field). A Config is the separate loading step: a JSON file (--config) plus
+// key=value overrides (--set servo.lambda=0.4), flattened to dotted keys.
+//
+// A Params struct exposes its fields through `template <class B> void bind(B& b)` calling
+// b("name", field) for each field; applyConfig() then overrides fields from a Config section
+// and calls validate(). Unknown keys are reported by Config::unusedKeys() so typos are caught.
+#include <nlohmann/json.hpp>
+
+#include <map>
+#include <set>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/error.h"
+
+namespace sketchnav {
+
+using Json = nlohmann::json;
+
+class Config {
+ public:
+  Config() = default;
+  /// Loads a JSON object from `path`; throws InputError naming the file on any problem.
+  static Config fromFile(const std::string& path);
+  /// Builds from a JSON object (nested objects are flattened to dotted keys).
+  static Config fromJson(const Json& j, const std::string& origin = "<json>");
+
+  /// Applies "a.b.c=value"; value is parsed as JSON when it is valid JSON, else a string.
+  void set(const std::string& assignment);
+  void set(const std::string& key, const Json& value);
+
+  bool has(const std::string& key) const;
+  const Json& at(const std::string& key) const;  // throws InputError when absent
+  /// The keys under `prefix.` (prefix empty = all keys).
+  std::vector<std::string> keys(const std::string& prefix = "") const;
+  /// Marks a key as consumed; unusedKeys() returns the rest (typos, stale settings).
+  void markUsed(const std::string& key) const;
+  std::vector<std::string> unusedKeys(const std::string& prefix = "") const;
+  /// Throws InputError naming the first unused key under `prefix`.
+  void requireAllUsed(const std::string& prefix = "") const;
+
+  const std::string& origin(const std::string& key) const;
+  Json toJson() const;  // nested form
+
+ private:
+  std::map<std::string, Json> values_;
+  std::map<std::string, std::string> origins_;
+  mutable std::set<std::string> used_;
+};
+
+namespace detail {
+template <class T>
+void assignFromJson(T& field, const Json& v, const std::string& key, const std::string& origin) {
+  try {
+    field = v.get<T>();
+  } catch (const std::exception&) {
+    throw InputError(origin + ": setting '" + key + "' has the wrong type (got " + v.dump() + ")");
+  }
+}
+
+class ConfigApplier {
+ public:
+  ConfigApplier(const Config& c, std::string prefix) : c_(c), prefix_(std::move(prefix)) {}
+  template <class T>
+  void operator()(const char* name, T& field) {
+    const std::string key = prefix_.empty() ? name : prefix_ + "." + name;
+    if (!c_.has(key)) return;
+    c_.markUsed(key);
+    assignFromJson(field, c_.at(key), key, c_.origin(key));
+  }
+
+ private:
+  const Config& c_;
+  std::string prefix_;
+};
+
+class JsonDumper {
+ public:
+  explicit JsonDumper(Json& out) : out_(out) {}
+  template <class T>
+  void operator()(const char* name, T& field) {
+    out_[name] = field;
+  }
+
+ private:
+  Json& out_;
+};
+}  // namespace detail
+
+/// Overrides fields of `params` from `config` keys under `prefix` (e.g. "servo"), then calls
+/// params.validate(). Throws InputError naming the key on a type error or invalid value.
+template <class P>
+void applyConfig(P& params, const Config& config, const std::string& prefix) {
+  detail::ConfigApplier a(config, prefix);
+  params.bind(a);
+  params.validate();
+}
+
+/// The params as a JSON object (for summaries: a run is reproducible from its summary).
+template <class P>
+Json paramsToJson(const P& params) {
+  Json j = Json::object();
+  detail::JsonDumper d(j);
+  const_cast<P&>(params).bind(d);
+  return j;
+}
+
+/// Helper for validate(): throws InputError "<owner>.<field> = <value>: <why>" when !ok.
+void require(bool ok, const std::string& field, const std::string& why);
+
+}  // namespace sketchnav

@@ -1,0 +1,116 @@
+#include "sketchnav/core/config.h"
+
+#include <fstream>
+#include <sstream>
+
+namespace sketchnav {
+namespace {
+void flatten(const Json& j, const std::string& prefix, const std::string& origin,
+             std::map<std::string, Json>& out, std::map<std::string, std::string>& origins) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
+    if (it->is_object()) {
+      flatten(*it, key, origin, out, origins);
+    } else {
+      out[key] = *it;
+      origins[key] = origin;
+    }
+  }
+}
+}  // namespace
+
+Config Config::fromJson(const Json& j, const std::string& origin) {
+  if (!j.is_object()) throw InputError(origin + ": a config must be a JSON object");
+  Config c;
+  flatten(j, "", origin, c.values_, c.origins_);
+  return c;
+}
+
+Config Config::fromFile(const std::string& path) {
+  std::ifstream in(path);
+  if (!in) throw InputError("config file '" + path + "' cannot be opened");
+  Json j;
+  try {
+    j = Json::parse(in);
+  } catch (const Json::parse_error& e) {
+    throw InputError("config file '" + path + "' is not valid JSON: " + e.what());
+  }
+  return fromJson(j, path);
+}
+
+void Config::set(const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0)
+    throw InputError("--set '" + assignment + "': expected key=value");
+  const std::string key = assignment.substr(0, eq);
+  const std::string text = assignment.substr(eq + 1);
+  Json v = Json::parse(text, nullptr, /*allow_exceptions=*/false);
+  if (v.is_discarded()) v = text;
+  set(key, v);
+  origins_[key] = "--set " + key;
+}
+
+void Config::set(const std::string& key, const Json& value) {
+  values_[key] = value;
+  if (!origins_.count(key)) origins_[key] = "<code>";
+}
+
+bool Config::has(const std::string& key) const {
+  return values_.count(key) != 0;
+}
+
+const Json& Config::at(const std::string& key) const {
+  auto it = values_.find(key);
+  if (it == values_.end()) throw InputError("missing setting '" + key + "'");
+  return it->second;
+}
+
+std::vector<std::string> Config::keys(const std::string& prefix) const {
+  std::vector<std::string> out;
+  for (const auto& [k, v] : values_)
+    if (prefix.empty() || k.rfind(prefix + ".", 0) == 0) out.push_back(k);
+  return out;
+}
+
+void Config::markUsed(const std::string& key) const {
+  used_.insert(key);
+}
+
+std::vector<std::string> Config::unusedKeys(const std::string& prefix) const {
+  std::vector<std::string> out;
+  for (const auto& k : keys(prefix))
+    if (!used_.count(k)) out.push_back(k);
+  return out;
+}
+
+void Config::requireAllUsed(const std::string& prefix) const {
+  const auto unused = unusedKeys(prefix);
+  if (!unused.empty())
+    throw InputError(origin(unused.front()) + ": unknown setting '" + unused.front() + "'");
+}
+
+const std::string& Config::origin(const std::string& key) const {
+  static const std::string unknown = "<config>";
+  auto it = origins_.find(key);
+  return it == origins_.end() ? unknown : it->second;
+}
+
+Json Config::toJson() const {
+  Json out = Json::object();
+  for (const auto& [k, v] : values_) {
+    Json* node = &out;
+    std::stringstream ss(k);
+    std::string part;
+    std::vector<std::string> parts;
+    while (std::getline(ss, part, '.')) parts.push_back(part);
+    for (size_t i = 0; i + 1 < parts.size(); ++i) node = &(*node)[parts[i]];
+    (*node)[parts.back()] = v;
+  }
+  return out;
+}
+
+void require(bool ok, const std::string& field, const std::string& why) {
+  if (!ok) throw InputError("invalid setting '" + field + "': " + why);
+}
+
+}  // namespace sketchnav

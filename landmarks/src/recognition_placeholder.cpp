@@ -1,0 +1,1 @@
+// Replaced by recognition (issue #6).

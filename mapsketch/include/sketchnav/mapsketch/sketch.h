@@ -1,0 +1,35 @@
+#pragma once
+// The hand-drawn map as the user drew it (canvas pixels, y down), and its file format
+// `.sketch.json` (doc/sketch-format.md). Nothing here is metric yet: toRoute() (route.h)
+// turns it into what the robot follows.
+#include <Eigen/Core>
+
+#include <string>
+#include <vector>
+
+namespace sketchnav::mapsketch {
+
+struct CanvasRect {
+  double x = 0, y = 0, w = 0, h = 0;  // [canvas px] top-left corner and size
+  Eigen::Vector2d centre() const { return {x + 0.5 * w, y + 0.5 * h}; }
+};
+
+struct SketchLandmark {
+  std::string id;          // unique within the sketch
+  std::string class_name;  // a class (leaf folder name) of the landmark set
+  CanvasRect rect;         // where the user put it
+  double distance_m = 0;   // user's approximate distance [m] from the previous landmark in
+                           // route order (from the start for the first one)
+};
+
+struct Sketch {
+  int format = 1;
+  double canvas_width = 1000, canvas_height = 700;  // [canvas px]
+  std::vector<SketchLandmark> landmarks;
+  std::vector<Eigen::Vector2d> path;  // the guide path as drawn, many jittery points [px]
+  Eigen::Vector2d start{0, 0};        // [px]
+  Eigen::Vector2d goal{0, 0};         // [px]
+  std::string name;                   // free text
+};
+
+}  // namespace sketchnav::mapsketch

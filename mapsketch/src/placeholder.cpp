@@ -1,0 +1,1 @@
+// Replaced by the sketch-map implementation (issue #4).

@@ -1,0 +1,1 @@
+// Replaced by the servo law (issue #7).
