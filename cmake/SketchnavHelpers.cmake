@@ -36,7 +36,10 @@ function(sketchnav_add_test name)
   if(NOT T_TIMEOUT)
     set(T_TIMEOUT 300)
   endif()
-  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60
-    PROPERTIES TIMEOUT ${T_TIMEOUT} LABELS "${T_LABELS}"
-    ENVIRONMENT "SKETCHNAV_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+  # An empty LABELS value would swallow the next keyword, so it is only passed when set.
+  set(props TIMEOUT ${T_TIMEOUT} ENVIRONMENT "SKETCHNAV_SOURCE_DIR=${PROJECT_SOURCE_DIR}")
+  if(T_LABELS)
+    list(APPEND props LABELS "${T_LABELS}")
+  endif()
+  gtest_discover_tests(${name} DISCOVERY_TIMEOUT 60 PROPERTIES ${props})
 endfunction()

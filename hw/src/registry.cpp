@@ -4,6 +4,7 @@
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/hw/file_cameras.h"
+#include "sketchnav/hw/hardware_drivers.h"
 
 namespace sketchnav::hw {
 namespace {
@@ -106,6 +107,7 @@ void registerBuiltinDrivers() {
       throw InputError("camera URI '" + uri.text + "': expected video:///file or video://INDEX");
     return std::make_unique<VideoCamera>(source, uri.paramDouble("hfov_deg", 60.0), uri.text);
   });
+  registerHardwareDrivers();
 }
 
 }  // namespace sketchnav::hw

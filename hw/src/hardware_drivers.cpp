@@ -1,0 +1,113 @@
+#include "sketchnav/hw/hardware_drivers.h"
+
+#include <fstream>
+#include <sstream>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/hw/aravis_camera.h"
+#include "sketchnav/hw/dani_base.h"
+#include "sketchnav/hw/gated_base.h"
+#include "sketchnav/hw/laser_sensors.h"
+#include "sketchnav/hw/rawlog.h"
+#include "sketchnav/hw/registry.h"
+
+namespace sketchnav::hw {
+namespace {
+
+// 0.2 rather than std::to_string's 0.200000, for messages.
+std::string shortNumber(double x) {
+  std::ostringstream o;
+  o << x;
+  return o.str();
+}
+
+// The shared secret never travels in a URI (URIs are logged and stored in summaries): it is
+// read from a file named by ?secret_file= or the config key base.dani.secret_file.
+std::string readSecret(const std::string& path, const std::string& what) {
+  if (path.empty()) return {};
+  std::ifstream in(path);
+  if (!in) throw InputError(what + ": cannot read secret file '" + path + "'");
+  std::stringstream ss;
+  ss << in.rdbuf();
+  std::string s = ss.str();
+  while (!s.empty() && (s.back() == '\n' || s.back() == '\r' || s.back() == ' ')) s.pop_back();
+  if (s.size() < 8) throw InputError(what + ": secret in '" + path + "' is shorter than 8 bytes");
+  return s;
+}
+
+std::shared_ptr<DaniLink> daniLink(const Uri& uri, DeviceContext& ctx) {
+  const std::string key = "dani://" + uri.authority;
+  if (auto it = ctx.shared.find(key); it != ctx.shared.end())
+    return std::any_cast<std::shared_ptr<DaniLink>>(it->second);
+  DaniParams p;
+  applyConfig(p, ctx.config, "base.dani");
+  p.link_timeout_s = uri.paramDouble("link_timeout_s", p.link_timeout_s);
+  p.connect_timeout_s = uri.paramDouble("connect_timeout_s", p.connect_timeout_s);
+  p.resume_on_connect = uri.paramInt("resume", p.resume_on_connect ? 1 : 0) != 0;
+  p.validate();
+  std::string secret_file;
+  if (ctx.config.has("base.dani.secret_file")) {
+    ctx.config.markUsed("base.dani.secret_file");
+    secret_file = ctx.config.at("base.dani.secret_file").get<std::string>();
+  }
+  secret_file = uri.param("secret_file", secret_file);
+  const std::string host = uri.host();
+  const int port = uri.port();
+  auto link = std::make_shared<DaniLink>(
+      host, port, p, ctx.clock, readSecret(secret_file, "base URI '" + uri.text + "'"), uri.text);
+  if (!link->connect(p.connect_timeout_s))
+    throw RuntimeError("base '" + uri.text + "': no answer from the base within " +
+                       shortNumber(p.connect_timeout_s) +
+                       " s (is it on, and is this laptop its allowed peer?)");
+  ctx.shared[key] = link;
+  return link;
+}
+
+}  // namespace
+
+std::unique_ptr<Base> stopBaseWhileCameraIsLost(std::unique_ptr<Base> base, Camera& camera) {
+  auto* live = dynamic_cast<AravisCamera*>(&camera);
+  if (!live) return base;
+  auto gated = std::make_unique<GatedBase>(std::move(base));
+  GatedBase* gate = gated.get();
+  live->setLinkCallback([gate](bool up) { gate->setOpen(up); });
+  return gated;
+}
+
+void registerHardwareDrivers() {
+  Registry& r = Registry::instance();
+  r.addCamera("aravis", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
+    AravisParams p;
+    applyConfig(p, ctx.config, "camera.aravis");
+    p.applyUri(uri);
+    p.validate();
+    return std::make_unique<AravisCamera>(uri.authority, p, ctx.clock, uri.text);
+  });
+  r.addBase("dani", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
+    return std::make_unique<DaniBase>(daniLink(uri, ctx));
+  });
+  r.addCamera("rawlog", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
+    if (uri.path.empty())
+      throw InputError("camera URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
+    return std::make_unique<RawlogCamera>(
+        uri.path, uri.param("label", ""), uri.text,
+        uri.paramInt("realtime", 0) != 0 ? (ctx.clock ? ctx.clock : std::make_shared<SteadyClock>())
+                                         : nullptr);
+  });
+  r.addBase("rawlog", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
+    if (uri.path.empty())
+      throw InputError("base URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
+    return std::make_unique<RawlogBase>(uri.path, ctx.clock, uri.param("label", "ODOMETRY"),
+                                        uri.text);
+  });
+  r.addRange("laser",
+             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); });
+  r.addRange("rawlog",
+             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); });
+  r.addRange("dani", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<RangeSensor> {
+    return std::make_unique<DaniSonar>(daniLink(uri, ctx));
+  });
+}
+
+}  // namespace sketchnav::hw
