@@ -30,6 +30,7 @@ struct Sketch {
   Eigen::Vector2d start{0, 0};        // [px]
   Eigen::Vector2d goal{0, 0};         // [px]
   std::string name;                   // free text
+  std::string notes;                  // free text for people (e.g. how it was drawn); optional
 };
 
 }  // namespace sketchnav::mapsketch

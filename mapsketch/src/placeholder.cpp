@@ -1,1 +1,0 @@
-// Replaced by the sketch-map implementation (issue #4).

@@ -1,0 +1,266 @@
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <map>
+
+#include "sketch_fixtures.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/mapsketch/io.h"
+#include "test_data.h"
+
+using namespace sketchnav;
+using namespace sketchnav::mapsketch;
+namespace fs = std::filesystem;
+
+namespace {
+Json good() {
+  return sketchToJson(fixtures::lSketch());
+}
+
+// Expects an InputError whose message contains every one of `parts`.
+void expectError(const Json& j, std::initializer_list<std::string> parts) {
+  try {
+    sketchFromJson(j, "t.sketch.json");
+    ADD_FAILURE() << "accepted: " << j.dump().substr(0, 200);
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_EQ(m.find('\n'), std::string::npos) << m;
+    EXPECT_EQ(m.rfind("t.sketch.json: ", 0), 0u) << m;
+    for (const auto& p : parts)
+      EXPECT_NE(m.find(p), std::string::npos) << "'" << p << "' not in: " << m;
+  }
+}
+}  // namespace
+
+TEST(SketchIo, RoundTripKeepsEverything) {
+  const Sketch a = fixtures::lSketch();
+  const Sketch b = sketchFromJson(sketchToJson(a));
+  EXPECT_EQ(b.format, 1);
+  EXPECT_EQ(b.name, a.name);
+  ASSERT_EQ(b.landmarks.size(), a.landmarks.size());
+  EXPECT_EQ(b.landmarks[2].class_name, a.landmarks[2].class_name);
+  EXPECT_DOUBLE_EQ(b.landmarks[2].rect.w, a.landmarks[2].rect.w);
+  EXPECT_DOUBLE_EQ(b.landmarks[2].distance_m, a.landmarks[2].distance_m);
+  ASSERT_EQ(b.path.size(), a.path.size());
+  EXPECT_EQ(b.path[17], a.path[17]);
+  EXPECT_EQ(b.start, a.start);
+  EXPECT_EQ(b.goal, a.goal);
+}
+
+TEST(SketchIo, FileTextParsesBackToTheSameSketch) {
+  Sketch a = fixtures::lSketch();
+  a.notes = "drawn by hand";
+  const std::string text = sketchToText(a);
+  EXPECT_EQ(sketchToJson(sketchFromText(text)), sketchToJson(a));
+  EXPECT_LT(std::count(text.begin(), text.end(), '\n'), static_cast<long>(a.path.size() / 8 + 20))
+      << "path points are packed, not one number per line";
+  EXPECT_EQ(text.find("\"format\""), 4u) << "format comes first for people reading the file";
+}
+
+TEST(SketchIo, SaveAndLoadAFile) {
+  const std::string dir = sketchnav::test::tempDir("sketchio");
+  const std::string p = dir + "/a.sketch.json";
+  saveSketch(fixtures::lSketch(), p);
+  const Sketch b = loadSketch(p);
+  EXPECT_EQ(b.landmarks.size(), 4u);
+  EXPECT_FALSE(fs::exists(p + ".tmp"));
+}
+
+TEST(SketchIo, PointsAsObjectsAreAccepted) {
+  Json j = good();
+  j["start"] = {{"x", 100}, {"y", 600}};
+  EXPECT_EQ(sketchFromJson(j).start, Eigen::Vector2d(100, 600));
+}
+
+TEST(SketchValidation, MissingOrWrongFormat) {
+  Json j = good();
+  j.erase("format");
+  expectError(j, {"format", "missing"});
+  j["format"] = 2;
+  expectError(j, {"format", "newer"});
+  j["format"] = "1";
+  expectError(j, {"format", "integer"});
+}
+
+TEST(SketchValidation, WrongTypesNameTheField) {
+  Json j = good();
+  j["landmarks"][1]["distance_m"] = "3";
+  expectError(j, {"landmarks[1].distance_m", "expected a number, got a string"});
+  j = good();
+  j["path"][3] = {1, 2, 3};
+  expectError(j, {"path[3]", "[x, y]"});
+  j = good();
+  j["landmarks"] = Json::object();
+  expectError(j, {"landmarks", "expected an array"});
+  j = good();
+  j["landmarks"][0]["rect"]["w"] = nullptr;
+  expectError(j, {"landmarks[0].rect.w", "null"});
+}
+
+TEST(SketchValidation, NaNAndInfinityAreRefused) {
+  Json j = good();
+  j["landmarks"][0]["distance_m"] = std::numeric_limits<double>::quiet_NaN();
+  expectError(j, {"landmarks[0].distance_m", "finite"});
+  j = good();
+  j["path"][5][0] = std::numeric_limits<double>::infinity();
+  expectError(j, {"path[5][0]", "finite"});
+}
+
+TEST(SketchValidation, NonPositiveAndAbsurdDistances) {
+  Json j = good();
+  j["landmarks"][2]["distance_m"] = 0;
+  expectError(j, {"landmarks[2].distance_m", "positive"});
+  j["landmarks"][2]["distance_m"] = -4;
+  expectError(j, {"landmarks[2].distance_m", "positive"});
+  j["landmarks"][2]["distance_m"] = 25000;
+  expectError(j, {"landmarks[2].distance_m", "absurd"});
+}
+
+TEST(SketchValidation, DuplicateIds) {
+  Json j = good();
+  j["landmarks"][3]["id"] = "A";
+  expectError(j, {"landmarks[3].id", "duplicate", "'A'"});
+}
+
+TEST(SketchValidation, TooFewPathPoints) {
+  Json j = good();
+  j["path"] = Json::array({{100, 600}});
+  expectError(j, {"path", "at least 2 points, got 1"});
+}
+
+TEST(SketchValidation, TooManyPathPoints) {
+  Json j = good();
+  Json path = Json::array();
+  for (size_t i = 0; i <= kMaxPathPoints; ++i) path.push_back({100 + 0.01 * i, 600});
+  j["path"] = path;
+  expectError(j, {"path", "too many points"});
+}
+
+TEST(SketchValidation, PathThatNeverComesNearALandmark) {
+  Json j = good();
+  for (auto& l : j["landmarks"]) {  // all landmarks into the top-left corner
+    l["rect"]["x"] = 10;
+    l["rect"]["y"] = 10;
+  }
+  j["path"] = Json::array({{600, 650}, {990, 650}});
+  j["start"] = {600, 650};
+  j["goal"] = {990, 650};
+  expectError(j, {"path", "never comes near a landmark"});
+}
+
+TEST(SketchValidation, UnknownFieldsAndBadGeometry) {
+  Json j = good();
+  j["landmark"] = Json::array();
+  expectError(j, {"landmark", "unknown field"});
+  j = good();
+  j["landmarks"][0]["rect"]["h"] = 0;
+  expectError(j, {"landmarks[0].rect", "positive"});
+  j = good();
+  j["goal"] = {5000, 100};
+  expectError(j, {"goal", "outside the canvas"});
+  j = good();
+  j["canvas"]["width"] = -1;
+  expectError(j, {"canvas.width"});
+  j = good();
+  j["landmarks"] = Json::array();
+  expectError(j, {"landmarks", "at least one"});
+}
+
+TEST(SketchValidation, UnknownClass) {
+  const Sketch s = fixtures::lSketch();
+  EXPECT_NO_THROW(
+      validateClasses(s, {"Oatly-Oat-Milk", "Arla-Standard-Milk", "Bravo-Orange-Juice"}));
+  try {
+    validateClasses(s, {"Oatly-Oat-Milk", "Arla-Standard-Milk"}, "f.sketch.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("landmarks[3].class: unknown class 'Bravo-Orange-Juice'"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(SketchValidation, BadJsonAndOversizedText) {
+  try {
+    sketchFromText("{\"format\": 1,,}", "x.sketch.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("x.sketch.json: not valid JSON"), std::string::npos)
+        << e.what();
+  }
+  const std::string big(kMaxSketchBytes + 1, ' ');
+  try {
+    sketchFromText(big, "big.sketch.json");
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("too large"), std::string::npos) << e.what();
+  }
+}
+
+TEST(SketchValidation, OversizedAndMissingFiles) {
+  const std::string dir = sketchnav::test::tempDir("sketchbig");
+  const std::string p = dir + "/big.sketch.json";
+  {
+    std::ofstream out(p);
+    out << std::string(kMaxSketchBytes + 10, ' ');
+  }
+  EXPECT_THROW(loadSketch(p), InputError);
+  EXPECT_THROW(loadSketch(dir + "/none.sketch.json"), InputError);
+}
+
+TEST(LandmarkSet, ClassesAreTheFolderNames) {
+  const auto classes = landmarkClasses(sketchnav::test::sourceDir() + "/share/landmarks");
+  EXPECT_EQ(classes.size(), 8u);
+  EXPECT_NE(std::find(classes.begin(), classes.end(), "Oatly-Oat-Milk"), classes.end());
+  EXPECT_THROW(landmarkClasses("/nonexistent-dir"), InputError);
+}
+
+TEST(Examples, ShippedSketchesAreValidAndConvert) {
+  const fs::path dir = fs::path(sketchnav::test::sourceDir()) / "share" / "sketches";
+  ASSERT_TRUE(fs::is_directory(dir));
+  const auto classes = landmarkClasses(sketchnav::test::sourceDir() + "/share/landmarks");
+  int n = 0;
+  for (const auto& e : fs::directory_iterator(dir)) {
+    const std::string name = e.path().filename().string();
+    if (name.size() < 12 || name.substr(name.size() - 12) != ".sketch.json") continue;
+    SCOPED_TRACE(name);
+    const Sketch s = loadSketch(e.path().string());
+    EXPECT_NO_THROW(validateClasses(s, classes));
+    const Route r = toRoute(s);
+    EXPECT_GE(r.sections.size(), 1u);
+    EXPECT_GT(r.total_length_m, 1.0);
+    ++n;
+  }
+  EXPECT_GE(n, 2);
+}
+
+TEST(Examples, LabSketchFollowsThePapersRoute) {
+  // The default sketch of `sketchnav run`: eight landmarks passed in the order of the lab
+  // world's route, on the sides a robot driving it sees them.
+  const Sketch s = loadSketch(sketchnav::test::sourceDir() + "/share/sketches/lab.sketch.json");
+  ASSERT_EQ(s.landmarks.size(), 8u);
+  EXPECT_GE(s.path.size(), 200u);
+  const Route r = toRoute(s);
+  std::vector<std::string> order;
+  std::map<std::string, Side> side;
+  for (const auto& sec : r.sections)
+    for (const auto& l : sec.landmarks) {
+      order.push_back(l.id);
+      side[l.id] = l.side;
+    }
+  EXPECT_EQ(order, (std::vector<std::string>{"L1", "L2", "L3", "L4", "L5", "L6", "L7", "L8"}));
+  EXPECT_EQ(side["L1"], Side::Right);
+  EXPECT_EQ(side["L2"], Side::Left);
+  EXPECT_EQ(side["L3"], Side::Right);
+  EXPECT_EQ(side["L5"], Side::Left);
+  EXPECT_EQ(side["L6"], Side::Left);
+  EXPECT_EQ(side["L7"], Side::Right);
+  // Drawn as a person would: the distances do not quite agree with the drawing, but the
+  // route is about as long as the real one (~22.5 m in an 18 x 13 m lab).
+  EXPECT_GT(r.scale_residual, 0.05);
+  EXPECT_GT(r.total_length_m, 18);
+  EXPECT_LT(r.total_length_m, 30);
+}
