@@ -1,18 +1,263 @@
 // sketchnav recognise: classify images with a landmark model; --eval DIR prints accuracy.
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <ctime>
+#include <filesystem>
 #include <iostream>
+#include <map>
 
 #include "cli.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
+#include "sketchnav/landmarks/landmark_set.h"
+#include "sketchnav/landmarks/objectness.h"
+#include "sketchnav/landmarks/recognition.h"
 
 namespace sketchnav::app {
 namespace {
-int runRecognise(const std::vector<std::string>& argv, GlobalOptions&) {
-  Args args("recognise", "classify images with a landmark model; --eval DIR prints accuracy",
-            "--model MODEL IMAGE...");
-  // Only --help is answered until the capability lands; everything else says so.
-  for (const auto& a : argv)
-    if (a == "--help" || a == "-h") return (std::cout << args.helpText(), 0);
-  return notAvailable("recognise", "landmark recognition", 6);
+
+namespace lm = landmarks;
+
+double threadCpuMs() {
+  timespec ts{};
+  clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
+  return ts.tv_sec * 1e3 + ts.tv_nsec * 1e-6;
 }
+
+struct Runner {
+  const lm::LandmarkModel& model;
+  lm::RecognitionParams params;
+  int windows = 0;  // objectness windows per image; 0 = whole image
+  std::unique_ptr<lm::Objectness> objectness;
+  cv::Size frame_size;      // non-empty: letterbox every image into a frame of this size
+  bool with_match = false;  // also run match() for the recognised class (servo cost)
+  lm::MatchParams match_params;
+
+  cv::Mat prepare(const cv::Mat& img) const {
+    if (frame_size.area() == 0) return img;
+    // Letterbox: the photo scaled to fit, centred on a grey frame, as a camera frame would be.
+    const double s = std::min(static_cast<double>(frame_size.width) / img.cols,
+                              static_cast<double>(frame_size.height) / img.rows);
+    cv::Mat scaled, frame(frame_size, CV_8UC3, cv::Scalar(127, 127, 127));
+    cv::resize(img, scaled, cv::Size(), s, s, s < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    scaled.copyTo(frame(cv::Rect((frame_size.width - scaled.cols) / 2,
+                                 (frame_size.height - scaled.rows) / 2, scaled.cols, scaled.rows)));
+    return frame;
+  }
+
+  // Recognition of one image, timed (features + windows + BoW + verification; not decoding):
+  // wall-clock ms, and this thread's CPU ms (robust to other processes sharing the cores).
+  std::vector<lm::Recognition> run(const cv::Mat& img, int top_k, double& ms,
+                                   double* cpu_ms = nullptr) const {
+    const double c0 = threadCpuMs();
+    const auto t0 = std::chrono::steady_clock::now();
+    std::vector<cv::Rect> boxes;
+    if (objectness)
+      for (const auto& w : objectness->propose(img, windows)) boxes.push_back(w.box);
+    const lm::FrameFeatures frame = lm::computeFrameFeatures(model, img);
+    auto out = lm::recognise(model, frame, boxes, top_k, params);
+    if (with_match && !out.empty() && !out.front().rejected)
+      lm::match(model, frame, out.front().window, out.front().class_name, match_params);
+    ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+    if (cpu_ms) *cpu_ms = threadCpuMs() - c0;
+    return out;
+  }
+};
+
+Json modeJson(const Runner& r) {
+  return {{"descriptor", r.model.params().features.root_sift ? "RootSIFT" : "SIFT"},
+          {"words", r.model.vocabulary().size()},
+          {"verify", r.params.verify},
+          {"windows", r.windows == 0 ? Json("whole image") : Json(r.windows)},
+          {"frame", r.frame_size.area() ? Json(std::to_string(r.frame_size.width) + "x" +
+                                               std::to_string(r.frame_size.height))
+                                        : Json("as is")},
+          {"match", r.with_match},
+          {"params", paramsToJson(r.params)}};
+}
+
+int evaluate(const Runner& runner, const std::string& dir, double index_ms, GlobalOptions& g) {
+  const lm::LandmarkSet set = lm::scanLandmarkSet(dir);
+  int n_known = 0, n_unknown = 0, top1 = 0, top1_any = 0, top3 = 0, false_rej = 0, unknown_rej = 0,
+      failed = 0;
+  double ms_sum = 0, cpu_sum = 0;
+  std::vector<double> times;
+  Json per_class = Json::object();
+  size_t total = 0, done = 0;
+  for (const auto& c : set.classes) total += c.photos.size();
+  for (const auto& c : set.classes) {
+    const bool known = runner.model.classId(c.name) >= 0;
+    Json pc = {{"images", 0}, {"top1", 0.0}, {"rejected", 0}, {"predicted", Json::object()}};
+    int pc_ok = 0, pc_n = 0;
+    for (const auto& path : c.photos) {
+      ++done;
+      if (!(g.json && !g.verbose))
+        std::cerr << "\rrecognise: " << done << "/" << total << std::flush;
+      cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
+      if (img.empty()) {
+        log::warn("recognise", "skipping unreadable image", {{"file", path}});
+        ++failed;
+        continue;
+      }
+      img = runner.prepare(img);
+      double ms = 0, cpu = 0;
+      const auto res = runner.run(img, 3, ms, &cpu);
+      ms_sum += ms;
+      cpu_sum += cpu;
+      times.push_back(ms);
+      const bool rejected = res.empty() || res.front().rejected;
+      const std::string pred = rejected ? "(none)" : res.front().class_name;
+      ++pc_n;
+      pc["predicted"][pred] = pc["predicted"].value(pred, 0) + 1;
+      if (rejected) pc["rejected"] = pc["rejected"].get<int>() + 1;
+      if (!known) {
+        ++n_unknown;
+        unknown_rej += rejected ? 1 : 0;
+        continue;
+      }
+      ++n_known;
+      if (rejected) ++false_rej;
+      if (!rejected && pred == c.name) ++top1, ++pc_ok;
+      if (!res.empty() && res.front().class_name == c.name) ++top1_any;
+      for (size_t i = 0; i < res.size() && i < 3; ++i)
+        if (res[i].class_name == c.name) {
+          ++top3;
+          break;
+        }
+    }
+    pc["images"] = pc_n;
+    pc["known"] = known;
+    pc["top1"] = pc_n ? static_cast<double>(pc_ok) / pc_n : 0.0;
+    per_class[c.name] = pc;
+  }
+  if (!(g.json && !g.verbose)) std::cerr << "\n";
+  const int n = n_known + n_unknown;
+  if (n == 0) throw InputError(dir + ": no readable images to evaluate");
+  std::sort(times.begin(), times.end());
+  auto frac = [](int a, int b) { return b ? static_cast<double>(a) / b : 0.0; };
+  Json j = {{"images", n},
+            {"classes", runner.model.classes().size()},
+            {"top1", frac(top1, n_known)},
+            {"top3", frac(top3, n_known)},
+            {"top1_ignoring_rejection", frac(top1_any, n_known)},
+            {"rejected", n_unknown ? Json(frac(unknown_rej, n_unknown)) : Json(nullptr)},
+            {"false_rejected", frac(false_rej, n_known)},
+            {"known_images", n_known},
+            {"unknown_images", n_unknown},
+            {"unreadable", failed},
+            {"ms_mean", ms_sum / n},
+            {"cpu_ms_mean", cpu_sum / n},
+            {"index_build_ms", index_ms},
+            {"ms_p95", times[std::min(times.size() - 1, times.size() * 95 / 100)]},
+            {"mode", modeJson(runner)},
+            {"per_class", per_class}};
+  if (g.json) {
+    printJson(j);
+    return 0;
+  }
+  std::printf("%-40s %6s %6s %8s  %s\n", "class", "images", "top1", "rejected", "predicted as");
+  for (const auto& [name, pc] : per_class.items()) {
+    std::string conf;
+    for (const auto& [p, k] : pc["predicted"].items())
+      if (p != name) conf += p + "×" + std::to_string(k.get<int>()) + " ";
+    std::printf("%-40s %6d %6.2f %8d  %s%s\n", name.c_str(), pc["images"].get<int>(),
+                pc["top1"].get<double>(), pc["rejected"].get<int>(), conf.c_str(),
+                pc["known"].get<bool>() ? "" : "(not in model)");
+  }
+  std::printf("\nimages %d (known %d, unknown %d), classes in model %zu\n", n, n_known, n_unknown,
+              runner.model.classes().size());
+  std::printf("top-1 %.3f   top-3 %.3f   false rejections %.3f\n", frac(top1, n_known),
+              frac(top3, n_known), frac(false_rej, n_known));
+  if (n_unknown) std::printf("rejected unknown-class images %.3f\n", frac(unknown_rej, n_unknown));
+  std::printf("ms per image: mean %.1f, p95 %.1f (CPU of this thread: mean %.1f)\n", ms_sum / n,
+              j["ms_p95"].get<double>(), cpu_sum / n);
+  return 0;
+}
+
+int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
+  Args args("recognise", "classify images with a landmark model; --eval DIR prints accuracy",
+            "--model MODEL IMAGE... | --model MODEL --eval DIR");
+  args.positionals("IMAGE", "images to classify", 0, -1)
+      .option("model", "landmark model (.slm) from `sketchnav train`")
+      .option("eval", "folder of class folders (same layout as training): print accuracy")
+      .option("top-k", "candidates printed per image", "3")
+      .option("windows", "objectness windows per image (0 = the whole image)", "0")
+      .option("frame", "letterbox each image into a WxH camera frame first, e.g. 640x480")
+      .flag("match", "also match the recognised class (the servo's per-frame cost) in the timing")
+      .flag("no-verify", "BoW + SVM only, no geometric verification (for comparisons)");
+  if (!args.parse(argv)) return 0;
+  if (args.get("model").empty()) throw InputError("sketchnav recognise: --model is required");
+  if (args.get("eval").empty() && args.positional().empty())
+    throw InputError("sketchnav recognise: give IMAGE... or --eval DIR");
+  const int top_k = args.getInt("top-k");
+  if (top_k < 1) throw InputError("sketchnav recognise: --top-k must be >= 1");
+  const lm::LandmarkModel model = lm::LandmarkModel::load(args.get("model"));
+  // Search indexes are built up front so per-image times are steady-state frame times.
+  const auto tb = std::chrono::steady_clock::now();
+  model.buildIndexes();
+  const double index_ms =
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tb).count();
+  Runner runner{model, {}, args.getInt("windows"), nullptr, {}, false, {}};
+  applyConfig(runner.params, g.config, "landmarks.recognition");
+  if (args.flagSet("no-verify")) runner.params.verify = false;
+  if (runner.windows < 0) throw InputError("sketchnav recognise: --windows must be >= 0");
+  runner.with_match = args.flagSet("match");
+  applyConfig(runner.match_params, g.config, "landmarks.match");
+  if (!args.get("frame").empty()) {
+    int w = 0, h = 0;
+    char x = 0;
+    if (std::sscanf(args.get("frame").c_str(), "%d%c%d", &w, &x, &h) != 3 || x != 'x' || w < 32 ||
+        h < 32)
+      throw InputError("sketchnav recognise: --frame expects WxH, e.g. 640x480");
+    runner.frame_size = cv::Size(w, h);
+  }
+  if (runner.windows > 0)
+    runner.objectness = std::make_unique<lm::Objectness>(lm::objectnessParamsFrom(g.config));
+
+  if (!args.get("eval").empty()) return evaluate(runner, args.get("eval"), index_ms, g);
+
+  Json out = Json::array();
+  int unreadable = 0;
+  for (const auto& path : args.positional()) {
+    cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
+    if (!img.empty()) img = runner.prepare(img);
+    if (img.empty()) {
+      if (args.positional().size() == 1) throw InputError(path + ": not a readable image");
+      log::warn("recognise", "skipping unreadable image", {{"file", path}});
+      ++unreadable;
+      continue;
+    }
+    double ms = 0;
+    const auto res = runner.run(img, top_k, ms);
+    Json cands = Json::array();
+    for (const auto& r : res)
+      cands.push_back({{"class", r.class_name},
+                       {"score", r.score},
+                       {"inliers", r.inliers},
+                       {"votes", r.votes},
+                       {"bow_probability", r.bow_probability},
+                       {"rejected", r.rejected},
+                       {"window", {r.window.x, r.window.y, r.window.width, r.window.height}}});
+    const bool rejected = res.empty() || res.front().rejected;
+    out.push_back({{"image", path},
+                   {"class", rejected ? Json(nullptr) : Json(res.front().class_name)},
+                   {"candidates", cands},
+                   {"ms", ms}});
+    if (!g.json) {
+      std::cout << path << ": " << (rejected ? "none of these" : res.front().class_name) << "\n";
+      for (const auto& r : res)
+        std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f%s\n", r.class_name.c_str(),
+                    r.score, r.inliers, r.bow_probability, r.rejected ? "  (not verified)" : "");
+    }
+  }
+  if (g.json) printJson({{"results", out}, {"unreadable", unreadable}, {"mode", modeJson(runner)}});
+  return unreadable ? 1 : 0;
+}
+
 const CommandRegistration reg("recognise",
                               "classify images with a landmark model; --eval DIR prints accuracy",
                               runRecognise);

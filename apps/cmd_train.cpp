@@ -1,18 +1,72 @@
 // sketchnav train: build a landmark model (.slm) from a folder of class folders.
+#include <chrono>
 #include <iostream>
 
 #include "cli.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/landmarks/model.h"
 
 namespace sketchnav::app {
 namespace {
-int runTrain(const std::vector<std::string>& argv, GlobalOptions&) {
+
+int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   Args args("train", "build a landmark model (.slm) from a folder of class folders",
-            "--landmarks DIR -o MODEL");
-  // Only --help is answered until the capability lands; everything else says so.
-  for (const auto& a : argv)
-    if (a == "--help" || a == "-h") return (std::cout << args.helpText(), 0);
-  return notAvailable("train", "landmark recognition", 6);
+            "--landmarks DIR -o MODEL [--vocabulary N] [--plain-sift] [--seed S]");
+  args.option("landmarks", "landmark set: a folder of class folders (a class = a leaf folder)")
+      .option("output", "model file to write (also -o)")
+      .option("vocabulary", "visual words (default: landmarks.train.vocabulary_size, 1000)")
+      .option("max-features", "SIFT keypoints per photo (default 500)")
+      .option("seed", "seed for sampling and k-means (default 1)")
+      .option("exclude", "comma-separated class names to leave out (rejection experiments)")
+      .flag("plain-sift", "use plain SIFT descriptors instead of RootSIFT (for comparisons)");
+  std::vector<std::string> argv;
+  for (size_t i = 0; i < argv_in.size(); ++i)
+    argv.push_back(argv_in[i] == "-o" ? "--output" : argv_in[i]);
+  if (!args.parse(argv)) return 0;
+  if (args.get("landmarks").empty())
+    throw InputError("sketchnav train: --landmarks DIR is required");
+  if (args.get("output").empty()) throw InputError("sketchnav train: -o MODEL is required");
+
+  landmarks::ModelParams p;
+  applyConfig(p, g.config, "landmarks.train");
+  if (!args.get("vocabulary").empty()) p.vocabulary_size = args.getInt("vocabulary");
+  if (!args.get("max-features").empty()) p.features.max_features = args.getInt("max-features");
+  if (!args.get("seed").empty()) p.seed = args.getInt("seed");
+  if (args.flagSet("plain-sift")) p.features.root_sift = false;
+  p.validate();
+
+  const auto t0 = std::chrono::steady_clock::now();
+  std::string last_stage;
+  auto progress = [&](const std::string& stage, int done, int total) {
+    if (g.json && !g.verbose) return;
+    if (stage != last_stage && !last_stage.empty()) std::cerr << "\n";
+    last_stage = stage;
+    std::cerr << "\rtrain: " << stage << " " << done << "/" << total << std::flush;
+  };
+  landmarks::LandmarkModel m =
+      landmarks::trainModel(args.get("landmarks"), p, progress, args.getList("exclude"));
+  if (!last_stage.empty() && !(g.json && !g.verbose)) std::cerr << "\n";
+  m.save(args.get("output"));
+  const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  Json j = {{"model", args.get("output")},
+            {"classes", m.classes().size()},
+            {"photos", m.photos().size()},
+            {"words", m.vocabulary().size()},
+            {"descriptor", p.features.root_sift ? "RootSIFT" : "SIFT"},
+            {"seconds", secs},
+            {"excluded", args.getList("exclude")},
+            {"params", paramsToJson(p)}};
+  if (g.json) {
+    printJson(j);
+  } else {
+    std::cout << "model      " << args.get("output") << "\nclasses    " << m.classes().size()
+              << "\nphotos     " << m.photos().size() << "\nwords      " << m.vocabulary().size()
+              << "\ndescriptor " << j["descriptor"].get<std::string>() << "\nseconds    " << secs
+              << "\n";
+  }
+  return 0;
 }
+
 const CommandRegistration reg("train",
                               "build a landmark model (.slm) from a folder of class folders",
                               runTrain);

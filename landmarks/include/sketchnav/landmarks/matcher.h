@@ -1,0 +1,90 @@
+#pragma once
+// Keypoint correspondences between a camera frame window and a landmark's database photos,
+// for the visual servo.
+//
+// Coordinates: x_t are pixels in the frame, x_d pixels in the matched database photo
+// (database_size). They are NOT directly comparable (different images, scales). The paper's
+// servo feature is x_t − x_d with both measured from their own image's vertical centre line;
+// use servoOffset() instead, which maps the database photo's centre into the frame through the
+// verified homography: object_u is the frame column of the matched object's centre and
+// offset_px = object_u − frame_width / 2 (> 0: the landmark is right of the image centre, so
+// the robot should turn right). The servo law can use offset_px (pixels) or
+// offset_px / f_x (normalised x) directly, and needs no geometry of its own.
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+#include "sketchnav/landmarks/model.h"
+
+namespace sketchnav::landmarks {
+
+/// Matching settings ("landmarks.match.*").
+struct MatchParams {
+  double ratio = 0.8;           // Lowe ratio test on the two nearest database descriptors
+  int min_inliers = 12;         // fewer RANSAC inliers -> not matched (never a guess)
+  double ransac_px = 6.0;       // [px in frame] RANSAC reprojection threshold
+  int max_photos = 3;           // database photos tried, best BoW-similar first
+  int strong_inliers = 40;      // stop trying further photos once one has this many
+  int min_window_features = 8;  // fewer keypoints in the window -> not matched
+
+  template <class B>
+  void bind(B& b) {
+    b("ratio", ratio);
+    b("min_inliers", min_inliers);
+    b("ransac_px", ransac_px);
+    b("max_photos", max_photos);
+    b("strong_inliers", strong_inliers);
+    b("min_window_features", min_window_features);
+  }
+  void validate() const;
+};
+
+/// Features of one camera frame, computed once and shared by recognise() and match() for
+/// every window of that frame.
+struct FrameFeatures {
+  Features features;
+  std::vector<int> words;  // visual word per keypoint
+};
+FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr);
+
+struct MatchResult {
+  bool matched = false;
+  int inliers = 0;
+  float confidence = 0;  // in [0, 1): 1 − exp(−(inliers − min_inliers + 1) / 15) when matched
+  std::vector<cv::Point2f> x_t;  // inlier keypoints in the frame [px]
+  std::vector<cv::Point2f> x_d;  // the same correspondences in the database photo [px]
+  cv::Mat H;                     // 3x3 CV_64F homography database photo -> frame (if matched)
+  cv::Size database_size;
+  std::string database_image;  // path of the photo relative to the landmark set
+  int database_photo = -1;     // index into LandmarkModel::photos()
+  cv::Rect window;             // the frame window searched
+  int photos_tried = 0;
+};
+
+/// Matches the window's keypoints against the target class's database photos (the photos most
+/// BoW-similar to the window first): ratio test, then RANSAC homography; the photo with the
+/// most inliers wins. An empty window means the whole frame. Unknown class -> InputError.
+MatchResult match(const LandmarkModel& model, const FrameFeatures& frame, const cv::Rect& window,
+                  const std::string& target_class, const MatchParams& params);
+/// Convenience: computes the frame's features first.
+MatchResult match(const LandmarkModel& model, const cv::Mat& frame_bgr, const cv::Rect& window,
+                  const std::string& target_class, const MatchParams& params);
+/// Verifies the window against one database photo (used by recognise() too).
+MatchResult matchPhoto(const LandmarkModel& model, const FrameFeatures& frame,
+                       const std::vector<int>& window_keypoints, int photo,
+                       const MatchParams& params);
+
+/// What the servo needs from a match, in frame pixels.
+struct ServoOffset {
+  bool valid = false;
+  float object_u = 0;         // [px] frame column of the matched object's centre
+  float offset_px = 0;        // [px] object_u − frame_width / 2 (> 0: object right of centre)
+  float paper_offset_px = 0;  // [px] median over inliers of (x_t − frame_cx) − s (x_d − db_cx),
+                              //      s = frame/database scale from H: the paper's x_t − x_d
+};
+/// Robust offsets from a match (the homography-projected database centre; falls back to
+/// the median inlier column when the homography is degenerate). Invalid when not matched.
+ServoOffset servoOffset(const MatchResult& m, int frame_width);
+
+}  // namespace sketchnav::landmarks

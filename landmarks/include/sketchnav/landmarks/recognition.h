@@ -1,0 +1,84 @@
+#pragma once
+// Landmark recognition in camera frames or object windows: BoW + linear SVM shortlist, then
+// geometric verification of the shortlisted classes against their database photos; classes
+// re-ranked by RANSAC inliers. A window whose best candidate does not verify is "none of
+// these" (rejected), never a guess.
+#include <opencv2/core.hpp>
+
+#include <string>
+#include <vector>
+
+#include "sketchnav/landmarks/matcher.h"
+#include "sketchnav/landmarks/model.h"
+
+namespace sketchnav::landmarks {
+
+/// Recognition settings ("landmarks.recognition.*").
+struct RecognitionParams {
+  int shortlist_classes = 2;  // top BoW (SVM) classes verified geometrically
+  int shortlist_votes = 3;    // + top classes by nearest-neighbour votes (matcher.h)
+  int knn = 8;                // neighbours per descriptor in the database-wide search
+  int search_checks = 16;     // FLANN kd-tree leaves visited per descriptor (speed/accuracy)
+  double class_ratio = 0.85;  // ratio test between the nearest and the nearest other class
+  bool vote_correspondences = false;  // true: verify with the vote search's correspondences
+                                      // (no per-photo search; faster, fewer inliers)
+  bool rank_by_votes = true;          // order verified classes by votes (discriminative: sibling
+                                      // products share artwork, so inliers alone tie) or by inliers
+  bool verify = true;                 // false = plain BoW + SVM (for comparisons)
+  double reject_probability = 0.2;    // BoW-only mode: best calibrated p below -> rejected
+  MatchParams match;                  // verification settings (min_inliers is the reject threshold)
+
+  template <class B>
+  void bind(B& b) {
+    b("shortlist_classes", shortlist_classes);
+    b("shortlist_votes", shortlist_votes);
+    b("knn", knn);
+    b("search_checks", search_checks);
+    b("class_ratio", class_ratio);
+    b("vote_correspondences", vote_correspondences);
+    b("rank_by_votes", rank_by_votes);
+    b("verify", verify);
+    b("reject_probability", reject_probability);
+    b("ratio", match.ratio);
+    b("min_inliers", match.min_inliers);
+    b("ransac_px", match.ransac_px);
+    b("max_photos", match.max_photos);
+    b("strong_inliers", match.strong_inliers);
+    b("min_window_features", match.min_window_features);
+  }
+  void validate() const;
+};
+
+struct Recognition {
+  std::string class_name;
+  float score = 0;  // verified: match confidence in [0,1); BoW-only: calibrated p
+  float bow_probability = 0;
+  int inliers = 0;  // RANSAC inliers against the best database photo (0 = not verified)
+  int votes = 0;    // window descriptors whose nearest database neighbour (ratio-tested
+                    // against other classes) belongs to this class
+  cv::Rect window;
+  bool rejected = false;  // no candidate verified (or p below threshold in BoW-only mode)
+};
+
+/// Up to top_k candidates per window, best first (verified classes by inliers, then the
+/// remaining BoW candidates, marked rejected). An empty `windows` means the whole frame.
+/// If the best candidate of a window is rejected, all its entries are rejected. Windows with
+/// fewer than match.min_window_features keypoints produce nothing.
+std::vector<std::vector<Recognition>> recogniseWindows(const LandmarkModel& model,
+                                                       const FrameFeatures& frame,
+                                                       const std::vector<cv::Rect>& windows,
+                                                       int top_k, const RecognitionParams& p);
+
+/// Candidates of all windows merged, one entry per class (from its best window), best first,
+/// at most top_k: verified classes by inliers, then unverified BoW candidates marked rejected.
+/// entries[0].rejected means "none of these" for the whole frame. Empty when no window had
+/// enough keypoints.
+std::vector<Recognition> recognise(const LandmarkModel& model, const cv::Mat& bgr,
+                                   const std::vector<cv::Rect>& windows, int top_k,
+                                   const RecognitionParams& p = {});
+/// The same on features computed once per frame (share them with match()).
+std::vector<Recognition> recognise(const LandmarkModel& model, const FrameFeatures& frame,
+                                   const std::vector<cv::Rect>& windows, int top_k,
+                                   const RecognitionParams& p = {});
+
+}  // namespace sketchnav::landmarks

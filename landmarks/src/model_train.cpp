@@ -1,0 +1,179 @@
+// Training a landmark model from a folder of class folders.
+#include <opencv2/imgcodecs.hpp>
+
+#include <algorithm>
+#include <filesystem>
+#include <mutex>
+
+#include "model_internal.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
+#include "sketchnav/landmarks/landmark_set.h"
+#include "sketchnav/landmarks/model.h"
+
+namespace fs = std::filesystem;
+
+namespace sketchnav::landmarks {
+
+void ModelParams::validate() const {
+  features.validate();
+  require(vocabulary_size >= 2, "train.vocabulary_size", "must be >= 2");
+  require(kmeans_sample >= 100, "train.kmeans_sample", "must be >= 100");
+  require(kmeans_iterations >= 1, "train.kmeans_iterations", "must be >= 1");
+  require(svm_c > 0, "train.svm_c", "must be > 0");
+  require(seed >= 0, "train.seed", "must be >= 0");
+}
+
+std::string landmarkSetFingerprint(const std::string& landmark_dir) {
+  const LandmarkSet set = scanLandmarkSet(landmark_dir);
+  std::string text;
+  std::error_code ec;
+  for (const auto& c : set.classes)
+    for (const auto& p : c.photos)
+      text += c.name + "|" + fs::relative(p, set.root).string() + "|" +
+              std::to_string(fs::file_size(p, ec)) + "\n";
+  char buf[17];
+  std::snprintf(buf, sizeof buf, "%016llx",
+                static_cast<unsigned long long>(detail::fnv1a(text.data(), text.size())));
+  return buf;
+}
+
+LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& params,
+                         const TrainProgress& progress, const std::vector<std::string>& exclude) {
+  params.validate();
+  const LandmarkSet set = scanLandmarkSet(landmark_dir);
+  LandmarkModel m;
+  m.params_ = params;
+  m.fingerprint_ = landmarkSetFingerprint(landmark_dir);
+
+  struct Item {
+    int cls;
+    std::string path;
+  };
+  std::vector<Item> items;
+  for (size_t c = 0; c < set.classes.size(); ++c) {
+    if (std::find(exclude.begin(), exclude.end(), set.classes[c].name) != exclude.end()) continue;
+    for (const auto& p : set.classes[c].photos) items.push_back({static_cast<int>(c), p});
+  }
+
+  // Features of every photo (the slow part: report progress).
+  std::vector<DatabasePhoto> photos;
+  const int total = static_cast<int>(items.size());
+  int skipped = 0;
+  for (int i = 0; i < total; ++i) {
+    if (progress) progress("features", i, total);
+    cv::Mat img;
+    try {
+      img = cv::imread(items[i].path, cv::IMREAD_COLOR);
+    } catch (const cv::Exception&) {
+      img.release();
+    }
+    if (img.empty()) {
+      log::warn("landmarks", "skipping unreadable photo", {{"file", items[i].path}});
+      ++skipped;
+      continue;
+    }
+    DatabasePhoto ph;
+    ph.class_id = items[i].cls;
+    ph.path = fs::relative(items[i].path, set.root).string();
+    ph.size = img.size();
+    detectSift(img, params.features, ph.keypoints, ph.sift_u8);
+    if (ph.keypoints.size() < 5) {
+      log::warn("landmarks", "skipping photo with too little texture",
+                {{"file", items[i].path}, {"features", std::to_string(ph.keypoints.size())}});
+      ++skipped;
+      continue;
+    }
+    photos.push_back(std::move(ph));
+  }
+  if (progress) progress("features", total, total);
+
+  // Classes that kept at least one photo, renumbered.
+  std::vector<int> remap(set.classes.size(), -1);
+  for (const auto& ph : photos) remap[ph.class_id] = 0;
+  for (size_t c = 0; c < set.classes.size(); ++c) {
+    if (remap[c] < 0) {
+      if (std::find(exclude.begin(), exclude.end(), set.classes[c].name) != exclude.end()) continue;
+      log::warn("landmarks", "dropping class without readable photos",
+                {{"class", set.classes[c].name}});
+      continue;
+    }
+    remap[c] = static_cast<int>(m.classes_.size());
+    m.classes_.push_back(set.classes[c].name);
+  }
+  if (m.classes_.empty())
+    throw InputError(landmark_dir + ": no class folder with a readable, textured photo");
+  for (auto& ph : photos) ph.class_id = remap[ph.class_id];
+
+  // Vocabulary over the working descriptors of all photos.
+  if (progress) progress("vocabulary", 0, 1);
+  int n_desc = 0;
+  for (const auto& ph : photos) n_desc += ph.sift_u8.rows;
+  cv::Mat all(n_desc, 128, CV_32F);
+  {
+    int r = 0;
+    for (auto& ph : photos) {
+      ph.descriptors = workingDescriptors(ph.sift_u8, params.features.root_sift);
+      ph.descriptors.copyTo(all.rowRange(r, r + ph.descriptors.rows));
+      r += ph.descriptors.rows;
+    }
+  }
+  VocabularyParams vp;
+  vp.size = params.vocabulary_size;
+  vp.sample = params.kmeans_sample;
+  vp.iterations = params.kmeans_iterations;
+  vp.seed = static_cast<unsigned>(params.seed);
+  Vocabulary vocab = Vocabulary::train(all, vp);
+  all.release();
+  std::vector<std::vector<int>> words(photos.size());
+  for (size_t i = 0; i < photos.size(); ++i) words[i] = vocab.assign(photos[i].descriptors);
+  vocab.computeIdf(words);
+  if (progress) progress("vocabulary", 1, 1);
+
+  // Classifier over the photos' histograms.
+  if (progress) progress("classifier", 0, 1);
+  cv::Mat hists(static_cast<int>(photos.size()), vocab.size(), CV_32F);
+  std::vector<int> labels(photos.size());
+  for (size_t i = 0; i < photos.size(); ++i) {
+    photos[i].words = words[i];
+    bowHistogram(words[i], vocab.idf()).copyTo(hists.row(static_cast<int>(i)));
+    labels[i] = photos[i].class_id;
+  }
+  m.classifier_ = LinearClassifier::train(hists, labels, static_cast<int>(m.classes_.size()),
+                                          params.svm_c, static_cast<unsigned>(params.seed));
+  if (progress) progress("classifier", 1, 1);
+  m.vocabulary_ = std::move(vocab);
+  m.photos_ = std::move(photos);
+  m.finalise();
+  log::info("landmarks", "model trained",
+            {{"classes", std::to_string(m.classes_.size())},
+             {"photos", std::to_string(m.photos_.size())},
+             {"skipped", std::to_string(skipped)},
+             {"words", std::to_string(m.vocabulary_.size())},
+             {"seed", std::to_string(params.seed)}});
+  return m;
+}
+
+LandmarkModel loadOrTrainModel(const std::string& landmark_dir, const std::string& cache_file,
+                               const ModelParams& params, const TrainProgress& progress) {
+  std::error_code ec;
+  if (fs::exists(cache_file, ec)) {
+    try {
+      LandmarkModel m = LandmarkModel::load(cache_file);
+      if (m.sourceFingerprint() == landmarkSetFingerprint(landmark_dir) &&
+          paramsToJson(m.params()) == paramsToJson(params))
+        return m;
+      log::info("landmarks", "cached model is stale, retraining", {{"file", cache_file}});
+    } catch (const InputError& e) {
+      log::warn("landmarks", "cached model unusable, retraining",
+                {{"file", cache_file}, {"why", e.what()}});
+    }
+  }
+  LandmarkModel m = trainModel(landmark_dir, params, progress);
+  if (fs::path(cache_file).has_parent_path())
+    fs::create_directories(fs::path(cache_file).parent_path(), ec);
+  m.save(cache_file);
+  return m;
+}
+
+}  // namespace sketchnav::landmarks

@@ -1,1 +1,0 @@
-// Replaced by objectness (issue #5).

@@ -1,1 +1,0 @@
-// Replaced by recognition (issue #6).

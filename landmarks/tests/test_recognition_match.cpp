@@ -1,0 +1,123 @@
+#include <gtest/gtest.h>
+
+#include <opencv2/imgproc.hpp>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/landmarks/matcher.h"
+#include "sketchnav/landmarks/model.h"
+#include "test_data.h"
+#include "test_recognition_support.h"
+
+using namespace sketchnav;
+using namespace sketchnav::landmarks;
+
+namespace {
+
+// A model whose class "class0" has one database photo: the flat object itself (so the true
+// database -> frame homography is the one used to warp it into the frame).
+class MatchFixture : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = test::tempDir("recog-match");
+    std::filesystem::create_directories(root_ + "/class0");
+    std::filesystem::create_directories(root_ + "/class1");
+    cv::imwrite(root_ + "/class0/flat.png", test::texturedImage(320, 240, 1000));
+    cv::imwrite(root_ + "/class1/flat.png", test::texturedImage(320, 240, 1001));
+    ModelParams p;
+    p.vocabulary_size = 50;
+    model_ = new LandmarkModel(trainModel(root_, p));
+  }
+  static void TearDownTestSuite() { delete model_; }
+  static std::string root_;
+  static LandmarkModel* model_;
+
+  // Warps the class0 photo into a 640x480 frame with H (photo -> frame).
+  static cv::Mat frameWith(const cv::Mat& H) {
+    cv::Mat frame(480, 640, CV_8UC3);
+    cv::RNG(3).fill(frame, cv::RNG::UNIFORM, 90, 160);
+    cv::GaussianBlur(frame, frame, cv::Size(0, 0), 4);
+    cv::warpPerspective(test::texturedImage(320, 240, 1000), frame, H, frame.size(),
+                        cv::INTER_LINEAR, cv::BORDER_TRANSPARENT);
+    return frame;
+  }
+
+  static void checkRecovered(const cv::Mat& H, const MatchResult& m) {
+    ASSERT_TRUE(m.matched);
+    EXPECT_GE(m.inliers, 20);
+    EXPECT_GT(m.confidence, 0.3f);
+    EXPECT_EQ(m.database_size, cv::Size(320, 240));
+    ASSERT_EQ(m.x_t.size(), m.x_d.size());
+    // Every inlier pair agrees with the true warp.
+    std::vector<cv::Point2f> proj;
+    cv::perspectiveTransform(m.x_d, proj, H);
+    for (size_t i = 0; i < proj.size(); ++i) EXPECT_LT(cv::norm(proj[i] - m.x_t[i]), 8.0);
+    // The servo offset: the object's centre column in the frame.
+    std::vector<cv::Point2f> c = {{160, 120}}, cf;
+    cv::perspectiveTransform(c, cf, H);
+    const ServoOffset o = servoOffset(m, 640);
+    ASSERT_TRUE(o.valid);
+    EXPECT_NEAR(o.object_u, cf[0].x, 4.0);
+    EXPECT_NEAR(o.offset_px, cf[0].x - 320, 4.0);
+    EXPECT_NEAR(o.paper_offset_px, cf[0].x - 320, 15.0);
+  }
+};
+std::string MatchFixture::root_;
+LandmarkModel* MatchFixture::model_ = nullptr;
+
+cv::Mat similarity(double angle_deg, double scale, double tx, double ty) {
+  cv::Mat A = cv::getRotationMatrix2D(cv::Point2f(160, 120), angle_deg, scale);
+  A.at<double>(0, 2) += tx;
+  A.at<double>(1, 2) += ty;
+  cv::Mat H = cv::Mat::eye(3, 3, CV_64F);
+  A.copyTo(H.rowRange(0, 2));
+  return H;
+}
+
+}  // namespace
+
+TEST_F(MatchFixture, RotatedCopyRightOfCentre) {
+  const cv::Mat H = similarity(30, 1.0, 300, 100);
+  checkRecovered(H, match(*model_, frameWith(H), cv::Rect(), "class0", MatchParams{}));
+}
+
+TEST_F(MatchFixture, ScaledCopyLeftOfCentre) {
+  const cv::Mat H = similarity(-5, 0.6, 20, 150);
+  const MatchResult m = match(*model_, frameWith(H), cv::Rect(), "class0", MatchParams{});
+  checkRecovered(H, m);
+  EXPECT_LT(servoOffset(m, 640).offset_px, 0.f) << "object left of centre -> negative";
+}
+
+TEST_F(MatchFixture, PerspectiveWarpedCopyInAWindow) {
+  const std::vector<cv::Point2f> src = {{0, 0}, {320, 0}, {320, 240}, {0, 240}};
+  const std::vector<cv::Point2f> dst = {{250, 90}, {560, 130}, {540, 360}, {260, 420}};
+  const cv::Mat H = cv::getPerspectiveTransform(src, dst);
+  const MatchResult m =
+      match(*model_, frameWith(H), cv::Rect(220, 60, 380, 400), "class0", MatchParams{});
+  checkRecovered(H, m);
+  EXPECT_EQ(m.window, cv::Rect(220, 60, 380, 400));
+  for (const auto& p : m.x_t) EXPECT_TRUE(cv::Rect2f(220, 60, 380, 400).contains(p));
+}
+
+TEST_F(MatchFixture, WrongClassOrEmptyWindowIsNotMatched) {
+  const cv::Mat H = similarity(10, 0.9, 150, 120);
+  const cv::Mat frame = frameWith(H);
+  const MatchResult other = match(*model_, frame, cv::Rect(), "class1", MatchParams{});
+  EXPECT_FALSE(other.matched);
+  EXPECT_TRUE(other.x_t.empty());
+  EXPECT_FALSE(servoOffset(other, 640).valid);
+  // A window away from the object holds too few keypoints: not matched, never a guess.
+  const MatchResult off = match(*model_, frame, cv::Rect(0, 0, 40, 40), "class0", MatchParams{});
+  EXPECT_FALSE(off.matched);
+  EXPECT_THROW(match(*model_, frame, cv::Rect(), "no-such-class", MatchParams{}), InputError);
+}
+
+TEST(MatchParamsTest, ValidateNamesTheField) {
+  MatchParams p;
+  p.min_inliers = 2;
+  try {
+    p.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("min_inliers"), std::string::npos);
+  }
+}

@@ -1,0 +1,246 @@
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/landmarks/landmark_set.h"
+#include "sketchnav/landmarks/model.h"
+#include "sketchnav/landmarks/recognition.h"
+#include "test_data.h"
+#include "test_recognition_support.h"
+
+using namespace sketchnav;
+using namespace sketchnav::landmarks;
+namespace fs = std::filesystem;
+
+namespace {
+
+ModelParams tinyParams() {
+  ModelParams p;
+  p.vocabulary_size = 64;
+  p.features.max_features = 300;
+  p.kmeans_iterations = 5;
+  return p;
+}
+
+std::string readAll(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  return std::string((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+}
+
+void writeAll(const std::string& path, const std::string& data) {
+  std::ofstream(path, std::ios::binary | std::ios::trunc) << data;
+}
+
+// One small model shared by the tests of this file (training takes about a second).
+class TinyModel : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    root_ = test::tempDir("recog-tiny");
+    test::writeLandmarkSet(root_, 3, 4, 7);
+    model_ = new LandmarkModel(trainModel(root_, tinyParams()));
+  }
+  static void TearDownTestSuite() {
+    delete model_;
+    model_ = nullptr;
+  }
+  static std::string root_;
+  static LandmarkModel* model_;
+};
+std::string TinyModel::root_;
+LandmarkModel* TinyModel::model_ = nullptr;
+
+}  // namespace
+
+TEST(LandmarkSet, LeafFoldersAreClassesAndJunkIsSkipped) {
+  const std::string root = test::tempDir("recog-scan");
+  fs::create_directories(root + "/Juice/Bravo-Apple-Juice");
+  fs::create_directories(root + "/Milk/Arla");
+  fs::create_directories(root + "/Empty");
+  cv::imwrite(root + "/Juice/Bravo-Apple-Juice/a.jpg", test::texturedImage(64, 64, 1));
+  cv::imwrite(root + "/Milk/Arla/b.PNG", test::texturedImage(64, 64, 2));
+  writeAll(root + "/Milk/Arla/notes.txt", "not a photo");
+  writeAll(root + "/Milk/stray.jpg", "x");
+  const LandmarkSet set = scanLandmarkSet(root);
+  ASSERT_EQ(set.classes.size(), 2u);
+  EXPECT_EQ(set.classes[0].name, "Arla");
+  EXPECT_EQ(set.classes[1].name, "Bravo-Apple-Juice");
+  EXPECT_EQ(set.classes[0].photos.size(), 1u);
+  EXPECT_EQ(set.skipped.size(), 3u);  // notes.txt, stray.jpg outside a leaf, Empty/
+  EXPECT_EQ(classOfImage(root + "/Juice/Bravo-Apple-Juice/a.jpg"), "Bravo-Apple-Juice");
+}
+
+TEST(LandmarkSet, MissingOrEmptyFolderIsInputErrorNamingIt) {
+  const std::string root = test::tempDir("recog-empty");
+  fs::create_directories(root + "/A");
+  try {
+    scanLandmarkSet(root);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find(root), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(scanLandmarkSet(root + "/nope"), InputError);
+}
+
+TEST(Train, CorruptPhotosAndEmptyClassesAreSkipped) {
+  const std::string root = test::tempDir("recog-corrupt");
+  test::writeLandmarkSet(root, 2, 2, 3);
+  fs::create_directories(root + "/group/onlyjunk");
+  writeAll(root + "/group/onlyjunk/broken.jpg", "\xff\xd8\xff\xe0 truncated jpeg");
+  writeAll(root + "/group/class0/broken.jpg", "\xff\xd8\xff garbage");
+  // A "very large" photo: downscaled before SIFT, keypoints reported in its own pixels.
+  const cv::Mat big = test::randomView(test::texturedImage(240, 180, 1000), 3000, 2200, 5, 10);
+  cv::imwrite(root + "/group/class0/big.jpg", big);
+  const LandmarkModel m = trainModel(root, tinyParams());
+  EXPECT_EQ(m.classes(), (std::vector<std::string>{"class0", "class1"}));
+  EXPECT_EQ(m.photos().size(), 5u);  // 2 + 2 + big
+  bool big_seen = false;
+  for (const auto& ph : m.photos()) {
+    if (ph.path.find("big.jpg") == std::string::npos) continue;
+    big_seen = true;
+    EXPECT_EQ(ph.size, cv::Size(3000, 2200));
+    float max_x = 0;
+    for (const auto& k : ph.keypoints) max_x = std::max(max_x, k.pt.x);
+    EXPECT_GT(max_x, 1500.f);
+  }
+  EXPECT_TRUE(big_seen);
+}
+
+TEST(Train, SingleClassWithOnePhotoWorks) {
+  const std::string root = test::tempDir("recog-single");
+  test::writeLandmarkSet(root, 1, 1, 11);
+  const LandmarkModel m = trainModel(root, tinyParams());
+  ASSERT_EQ(m.classes().size(), 1u);
+  // A new view of the object is recognised (verification decides; the SVM cannot).
+  const cv::Mat view = test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 99, 15);
+  const auto r = recognise(m, view, {}, 1);
+  ASSERT_FALSE(r.empty());
+  EXPECT_FALSE(r[0].rejected);
+  EXPECT_EQ(r[0].class_name, "class0");
+  // An unrelated image is not.
+  const auto u = recognise(m, test::texturedImage(320, 240, 4242), {}, 1);
+  ASSERT_FALSE(u.empty());
+  EXPECT_TRUE(u[0].rejected);
+}
+
+TEST(Train, NoUsablePhotoIsInputError) {
+  const std::string root = test::tempDir("recog-nophoto");
+  fs::create_directories(root + "/A");
+  writeAll(root + "/A/x.jpg", "not a jpeg");
+  EXPECT_THROW(trainModel(root, tinyParams()), InputError);
+}
+
+TEST_F(TinyModel, RecognisesHeldOutViewsAndRejectsUnknownObjects) {
+  int correct = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) {
+      const cv::Mat view = test::randomView(test::texturedImage(240, 180, 1000 + k), 320, 240,
+                                            5000 + 10 * k + i, 20);
+      const auto r = recognise(*model_, view, {}, 3);
+      ASSERT_FALSE(r.empty());
+      correct += !r[0].rejected && r[0].class_name == "class" + std::to_string(k);
+    }
+  EXPECT_GE(correct, 8) << "of 9 held-out views";
+  int rejected = 0;
+  for (int i = 0; i < 3; ++i) {
+    const cv::Mat unknown =
+        test::randomView(test::texturedImage(240, 180, 7777 + i), 320, 240, 6000 + i, 20);
+    const auto r = recognise(*model_, unknown, {}, 3);
+    rejected += r.empty() || r[0].rejected;
+  }
+  EXPECT_EQ(rejected, 3);
+}
+
+TEST_F(TinyModel, WindowsRestrictTheSearch) {
+  // Two objects side by side; each window recognises its own.
+  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 8001, 5)
+      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
+  test::randomView(test::texturedImage(240, 180, 1002), 320, 240, 8002, 5)
+      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
+  const FrameFeatures f = computeFrameFeatures(*model_, frame);
+  const auto per = recogniseWindows(
+      *model_, f, {cv::Rect(0, 0, 320, 240), cv::Rect(320, 0, 320, 240)}, 1, RecognitionParams{});
+  ASSERT_EQ(per.size(), 2u);
+  ASSERT_FALSE(per[0].empty());
+  ASSERT_FALSE(per[1].empty());
+  EXPECT_EQ(per[0][0].class_name, "class0");
+  EXPECT_EQ(per[1][0].class_name, "class2");
+  EXPECT_FALSE(per[0][0].rejected);
+  EXPECT_EQ(per[1][0].window, cv::Rect(320, 0, 320, 240));
+}
+
+TEST_F(TinyModel, SaveLoadRoundTripGivesTheSameAnswers) {
+  const std::string path = test::tempDir("recog-io") + "/m.slm";
+  model_->save(path);
+  const LandmarkModel m = LandmarkModel::load(path);
+  EXPECT_EQ(m.classes(), model_->classes());
+  EXPECT_EQ(m.photos().size(), model_->photos().size());
+  EXPECT_EQ(m.vocabulary().size(), model_->vocabulary().size());
+  EXPECT_EQ(m.sourceFingerprint(), model_->sourceFingerprint());
+  const cv::Mat view = test::randomView(test::texturedImage(240, 180, 1001), 320, 240, 31, 10);
+  const auto a = recognise(*model_, view, {}, 3), b = recognise(m, view, {}, 3);
+  ASSERT_EQ(a.size(), b.size());
+  for (size_t i = 0; i < a.size(); ++i) {
+    EXPECT_EQ(a[i].class_name, b[i].class_name);
+    EXPECT_EQ(a[i].inliers, b[i].inliers);
+  }
+}
+
+TEST_F(TinyModel, TruncatedCorruptOrForeignFilesAreInputErrorsNamingTheFile) {
+  const std::string dir = test::tempDir("recog-bad");
+  const std::string good = dir + "/good.slm";
+  model_->save(good);
+  const std::string data = readAll(good);
+  auto expectInputError = [&](const std::string& path, const std::string& what) {
+    try {
+      LandmarkModel::load(path);
+      FAIL() << "expected InputError for " << what;
+    } catch (const InputError& e) {
+      const std::string msg = e.what();
+      EXPECT_NE(msg.find(path), std::string::npos) << msg;
+      EXPECT_NE(msg.find(what), std::string::npos) << msg;
+    }
+  };
+  writeAll(dir + "/trunc.slm", data.substr(0, data.size() / 2));
+  expectInputError(dir + "/trunc.slm", "truncated");
+  writeAll(dir + "/short.slm", data.substr(0, 10));
+  expectInputError(dir + "/short.slm", "truncated");
+  std::string flipped = data;
+  flipped[flipped.size() - 7] ^= 0x55;
+  writeAll(dir + "/flip.slm", flipped);
+  expectInputError(dir + "/flip.slm", "checksum");
+  std::string other = data;
+  other[8] = static_cast<char>(LandmarkModel::kFormatVersion + 1);
+  writeAll(dir + "/v2.slm", other);
+  expectInputError(dir + "/v2.slm", "version");
+  writeAll(dir + "/text.slm", "hello, I am not a model");
+  expectInputError(dir + "/text.slm", "not a sketchnav landmark model");
+  expectInputError(dir + "/missing.slm", "not found");
+}
+
+TEST_F(TinyModel, LoadOrTrainReusesAFreshCacheAndRetrainsAStaleOne) {
+  const std::string cache = test::tempDir("recog-cache") + "/sub/default.slm";
+  const LandmarkModel a = loadOrTrainModel(root_, cache, tinyParams());
+  ASSERT_TRUE(fs::exists(cache));
+  const auto t = fs::last_write_time(cache);
+  const LandmarkModel b = loadOrTrainModel(root_, cache, tinyParams());
+  EXPECT_EQ(fs::last_write_time(cache), t) << "a fresh cache is not rewritten";
+  EXPECT_EQ(b.classes(), a.classes());
+  writeAll(cache, "garbage");
+  const LandmarkModel c = loadOrTrainModel(root_, cache, tinyParams());
+  EXPECT_EQ(c.classes(), a.classes());
+  EXPECT_NO_THROW(LandmarkModel::load(cache));
+}
+
+TEST(ModelParams, ValidateNamesTheField) {
+  ModelParams p;
+  p.vocabulary_size = 1;
+  try {
+    p.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("vocabulary_size"), std::string::npos);
+  }
+}
