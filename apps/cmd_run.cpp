@@ -2,17 +2,63 @@
 #include <iostream>
 
 #include "cli.h"
+#include "run_harness.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/paths.h"
 
 namespace sketchnav::app {
 namespace {
-int runRun(const std::vector<std::string>& argv, GlobalOptions&) {
+
+int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("run", "navigate: the simulated lab by default, or a real robot via device URIs",
-            "[options]");
-  // Only --help is answered until the capability lands; everything else says so.
-  for (const auto& a : argv)
-    if (a == "--help" || a == "-h") return (std::cout << args.helpText(), 0);
-  return notAvailable("run", "the navigation executive (servo and navigation)", 7);
+            "[--world NAME|FILE] [--sketch FILE] [--model FILE] [--seed N] [--realtime] "
+            "[--out DIR] [--robot URI --camera URI --laser URI --sonar URI]");
+  args.option("world", "simulated world: a name in share/worlds or a .world.json file", "lab")
+      .option("sketch", "the hand-drawn map (.sketch.json); default: the world's sketch")
+      .option("model",
+              "landmark model (.slm); default: the demo landmark set, trained on "
+              "first use and cached")
+      .option("landmarks", "landmark set folder to train the model from (default: share/landmarks)")
+      .option("cache-dir", "where trained models are cached (default: ~/.cache/sketchnav)")
+      .option("seed", "simulator seed (noise, odometry errors)", "1")
+      .flag("realtime", "simulate at wall-clock pace (default: as fast as the CPU allows)")
+      .option("max-time", "give up after this many seconds of run time (default: nav.max_time_s)")
+      .option("out", "output folder (default: runs/<UTC timestamp>)")
+      .option("robot", "base URI for a real robot, e.g. dani://192.168.1.20:5000")
+      .option("camera", "camera URI, e.g. aravis://192.168.1.10 or video://0")
+      .option("laser", "laser URI")
+      .option("sonar", "sonar URI");
+  if (!args.parse(argv)) return 0;
+  RunOptions o;
+  o.world = args.get("world");
+  o.sketch = args.get("sketch");
+  o.model = args.get("model");
+  o.landmark_dir = args.get("landmarks");
+  o.cache_dir = args.get("cache-dir");
+  o.seed = args.getInt("seed");
+  o.realtime = args.flagSet("realtime");
+  if (!args.get("max-time").empty()) o.max_time_s = args.getDouble("max-time");
+  o.robot = args.get("robot");
+  o.camera = args.get("camera");
+  o.laser = args.get("laser");
+  o.sonar = args.get("sonar");
+  o.config = g.config;
+  o.out_dir = makeOutputDir(args.get("out"));
+  o.progress = true;
+  const Json summary = runNavigation(o);
+  if (g.json) {
+    printJson(summary);
+  } else {
+    std::cout << (summary["success"].get<bool>() ? "success" : "FAILED") << ": "
+              << summary["reason"].get<std::string>() << "\n"
+              << "time " << summary["time_s"].get<double>() << " s (real-time factor "
+              << summary["real_time_factor"].get<double>() << "), path "
+              << summary["path_length_m"].get<double>() << " m\n"
+              << "outputs in " << o.out_dir << "\n";
+  }
+  return summary["success"].get<bool>() ? 0 : 1;
 }
+
 const CommandRegistration reg(
     "run", "navigate: the simulated lab by default, or a real robot via device URIs", runRun);
 }  // namespace

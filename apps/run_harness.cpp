@@ -1,0 +1,446 @@
+#include "run_harness.h"
+
+#include <opencv2/imgproc.hpp>
+
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <iomanip>
+#include <iostream>
+#include <sstream>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
+#include "sketchnav/core/paths.h"
+#include "sketchnav/hw/registry.h"
+#include "sketchnav/landmarks/model.h"
+#include "sketchnav/mapsketch/io.h"
+#include "sketchnav/mapsketch/route.h"
+#include "sketchnav/nav/executive.h"
+#include "sketchnav/sim/map_render.h"
+#include "sketchnav/sim/register.h"
+#include "sketchnav/sim/simulator.h"
+
+namespace sketchnav::app {
+namespace fs = std::filesystem;
+
+std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir) {
+  std::string dir = cache_dir;
+  if (dir.empty()) {
+    if (const char* x = std::getenv("XDG_CACHE_HOME"); x && *x)
+      dir = std::string(x) + "/sketchnav";
+    else if (const char* h = std::getenv("HOME"); h && *h)
+      dir = std::string(h) + "/.cache/sketchnav";
+    else
+      dir = (fs::temp_directory_path() / "sketchnav-cache").string();
+  }
+  // FNV-1a of the landmark set's fingerprint (paths + sizes): a changed set gets a new file.
+  std::uint64_t h = 1469598103934665603ull;
+  for (unsigned char c : landmarks::landmarkSetFingerprint(landmark_dir)) {
+    h ^= c;
+    h *= 1099511628211ull;
+  }
+  std::ostringstream name;
+  name << "landmarks-" << std::hex << std::setw(16) << std::setfill('0') << h << ".slm";
+  return (fs::path(dir) / name.str()).string();
+}
+
+namespace {
+
+bool looksLikePath(const std::string& s) {
+  return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
+}
+
+// Route frame -> world frame for drawing: the route's start at the world start pose, facing
+// along the first section (the executive's initial alignment).
+struct RouteToWorld {
+  hw::Pose2D start;
+  Eigen::Vector2d route_start{0, 0};
+  double rot = 0;
+  Eigen::Vector2d operator()(const Eigen::Vector2d& p) const {
+    const Eigen::Vector2d d = p - route_start;
+    const double a = rot, c = std::cos(a), s = std::sin(a);
+    const Eigen::Vector2d o(c * d.x() - s * d.y(), s * d.x() + c * d.y());  // odometry frame
+    const double cs = std::cos(start.theta), ss = std::sin(start.theta);
+    return {start.x + cs * o.x() - ss * o.y(), start.y + ss * o.x() + cs * o.y()};
+  }
+};
+
+double distToPolyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& poly) {
+  double best = 1e300;
+  for (size_t i = 0; i + 1 < poly.size(); ++i) {
+    const Eigen::Vector2d a = poly[i], d = poly[i + 1] - a;
+    const double L2 = d.squaredNorm();
+    const double t = L2 > 0 ? std::clamp((p - a).dot(d) / L2, 0.0, 1.0) : 0.0;
+    best = std::min(best, (a + t * d - p).norm());
+  }
+  if (poly.size() == 1) best = (poly[0] - p).norm();
+  return best;
+}
+
+class RunObserver final : public nav::ExecutiveObserver {
+ public:
+  RunObserver(const std::string& out, bool progress, sim::Simulator* sim, int sections)
+      : progress_(progress), sim_(sim), sections_(sections) {
+    if (!out.empty()) {
+      events_.open(out + "/events.jsonl");
+      tele_.open(out + "/telemetry.csv");
+      if (!events_ || !tele_) throw RuntimeError("cannot write run files in " + out);
+      tele_ << "t,odom_x,odom_y,odom_theta,true_x,true_y,true_theta,v_cmd,w_cmd,servo_error,"
+               "mode,turn,section,landmark,front_free_m\n";
+    }
+  }
+  std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
+
+  void onEvent(const nlohmann::json& e) override {
+    if (events_.is_open()) events_ << e.dump() << std::endl;  // flushed per line
+    if (!progress_) return;
+    const std::string type = e.value("type", "");
+    char head[64];
+    std::snprintf(head, sizeof head, "[t=%6.1fs] ", e.value("t", 0.0));
+    std::string msg;
+    auto sec = [&](const nlohmann::json& j) {
+      return "section " + std::to_string(j.value("section", 0) + 1) + "/" +
+             std::to_string(sections_);
+    };
+    if (type == "start")
+      msg = "start: " + std::to_string(sections_) + " sections";
+    else if (type == "landmark_seen")
+      msg = sec(e) + ": landmark " + e.value("id", "") + " (" + e.value("class", "") + ") seen, " +
+            std::to_string(e.value("inliers", 0)) + " inliers, range " +
+            fmt(e.value("range_m", 0.0)) + " m";
+    else if (type == "landmark_passed")
+      msg = sec(e) + ": landmark " + e.value("id", "") + " passed";
+    else if (type == "landmark_missed")
+      msg = sec(e) + ": landmark " + e.value("id", "") + " not seen, continuing on odometry";
+    else if (type == "landmark_lost")
+      msg = sec(e) + ": landmark " + e.value("id", "") + " lost";
+    else if (type == "section_done")
+      msg = "section " + std::to_string(e.value("section", 0) + 1) + "/" +
+            std::to_string(sections_) + " done";
+    else if (type == "avoid_start")
+      msg = sec(e) + ": obstacle " + fmt(e.value("front_free_m", 0.0)) + " m ahead, dodging " +
+            e.value("side", "");
+    else if (type == "avoid_end")
+      msg = "obstacle cleared";
+    else if (type == "fault")
+      msg = "FAULT: " + e.value("reason", "");
+    else if (type == "arrived" || type == "failed")
+      msg = type + ": " + e.value("reason", "");
+    if (!msg.empty()) std::cerr << head << msg << "\n";
+  }
+
+  void onTick(const nav::TelemetryRow& r) override {
+    hw::Pose2D truth;
+    if (sim_) truth = sim_->truePose();
+    odom.push_back(r.odom);
+    if (tele_.is_open()) {
+      tele_ << r.t << ',' << r.odom.x << ',' << r.odom.y << ',' << r.odom.theta << ',';
+      if (sim_)
+        tele_ << truth.x << ',' << truth.y << ',' << truth.theta << ',';
+      else
+        tele_ << ",,,";
+      tele_ << r.v_cmd << ',' << r.w_cmd << ',';
+      if (std::isfinite(r.servo_error)) tele_ << r.servo_error;
+      tele_ << ',' << r.mode << ',' << r.turn << ',' << r.section << ',' << r.landmark << ','
+            << r.front_free_m << '\n';
+    }
+    if (progress_ && r.t >= next_progress_) {
+      next_progress_ = r.t + 5.0;
+      char buf[200];
+      std::snprintf(buf, sizeof buf,
+                    "[t=%6.1fs] section %d/%d %-6s v=%.2f m/s w=%+.2f rad/s %-8s landmark %s", r.t,
+                    r.section + 1, sections_, r.mode.c_str(), r.v_cmd, r.w_cmd, r.turn.c_str(),
+                    r.landmark.empty() ? "-" : r.landmark.c_str());
+      std::cerr << buf << "\n";
+    }
+  }
+
+ private:
+  static std::string fmt(double v) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.2f", v);
+    return b;
+  }
+  bool progress_;
+  sim::Simulator* sim_;
+  int sections_;
+  std::ofstream events_, tele_;
+  double next_progress_ = 0;
+};
+
+void drawTrajectory(const std::string& path, const sim::World& world,
+                    const mapsketch::Sketch& sketch, const mapsketch::Route& route,
+                    const RouteToWorld& r2w, const std::vector<hw::Pose2D>& traj) {
+  sim::MapCanvas canvas(world, 40.0, 0.5, true);
+  // The hand-drawn path as drawn (canvas px -> route frame -> world), solid.
+  std::vector<Eigen::Vector2d> drawn;
+  for (const auto& p : sketch.path) {
+    const Eigen::Vector2d rp((p.x() - sketch.start.x()) * route.scale_m_per_px,
+                             -(p.y() - sketch.start.y()) * route.scale_m_per_px);
+    drawn.push_back(r2w(rp + route.start_m));
+  }
+  canvas.drawPolyline(drawn, {0, 0, 0}, false, 2);
+  // Where the sketch put the landmarks (hollow grey), next to the real ones the map shows.
+  for (const auto& sec : route.sections)
+    for (const auto& lm : sec.landmarks) {
+      canvas.drawStar(r2w(lm.position_m), {150, 150, 150}, 6);
+      canvas.drawText(r2w(lm.position_m) + Eigen::Vector2d(0.15, -0.15), lm.id + "?",
+                      {120, 120, 120}, 0.35);
+    }
+  canvas.drawPoses(traj, {200, 60, 20}, true, 2);
+  canvas.drawStart({world.start.x, world.start.y});
+  canvas.drawGoal(world.goal.centre, world.goal.radius);
+  canvas.drawLegend({{"sketched path", {0, 0, 0}},
+                     {"actual trajectory (dashed)", {200, 60, 20}},
+                     {"sketched landmark position", {150, 150, 150}}});
+  canvas.save(path);
+}
+
+}  // namespace
+
+Json runNavigation(const RunOptions& o) {
+  using wall = std::chrono::steady_clock;
+  hw::registerBuiltinDrivers();
+  sim::registerDrivers();
+  const bool hardware =
+      !o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty();
+  if (o.seed < 0) throw InputError("--seed must be >= 0");
+  hw::DeviceContext ctx;
+  ctx.config = o.config;
+  if (o.realtime) ctx.config.set("sim.realtime", true);
+
+  // --- devices ----------------------------------------------------------------------------
+  std::shared_ptr<sim::Simulator> simr;
+  std::unique_ptr<hw::Camera> camera;
+  std::unique_ptr<hw::Base> base;
+  std::unique_ptr<hw::RangeSensor> laser, sonar;
+  std::string world_name = o.world;
+  if (!hardware) {
+    std::string world_uri;
+    if (looksLikePath(o.world)) {
+      if (!fs::exists(o.world)) throw InputError("--world " + o.world + ": no such file");
+      world_uri = "sim://" + fs::absolute(o.world).string();
+    } else {
+      world_uri = "sim://" + o.world;
+    }
+    const std::string q = "?seed=" + std::to_string(o.seed);
+    simr = sim::simulatorFor(world_uri + q, ctx);
+    base = hw::Registry::instance().createBase(world_uri + q, ctx);
+    camera = hw::Registry::instance().createCamera(world_uri + q, ctx);
+    if (simr->world().laser.enabled)
+      laser = hw::Registry::instance().createRange(world_uri + q + "&sensor=laser", ctx);
+    if (simr->world().sonar.enabled)
+      sonar = hw::Registry::instance().createRange(world_uri + q + "&sensor=sonar", ctx);
+  } else {
+    if (o.robot.empty()) throw InputError("--robot URI is required with hardware devices");
+    ctx.clock = std::make_shared<hw::SteadyClock>();
+    base = hw::Registry::instance().createBase(o.robot, ctx);
+    if (!o.camera.empty()) camera = hw::Registry::instance().createCamera(o.camera, ctx);
+    if (!o.laser.empty()) laser = hw::Registry::instance().createRange(o.laser, ctx);
+    if (!o.sonar.empty()) sonar = hw::Registry::instance().createRange(o.sonar, ctx);
+  }
+  if (o.wrap_camera && camera) camera = o.wrap_camera(std::move(camera));
+  if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
+
+  // --- sketch -> route ----------------------------------------------------------------------
+  std::string sketch_path = o.sketch;
+  if (sketch_path.empty()) {
+    if (looksLikePath(o.world)) {
+      std::string p = o.world;
+      const std::string suffix = ".world.json";
+      if (p.size() > suffix.size() && p.substr(p.size() - suffix.size()) == suffix)
+        p = p.substr(0, p.size() - suffix.size()) + ".sketch.json";
+      if (!fs::exists(p)) throw InputError("--sketch is required (no " + p + ")");
+      sketch_path = p;
+    } else {
+      sketch_path = resourcePath("sketches/" + o.world + ".sketch.json");
+    }
+  }
+  const mapsketch::Sketch sketch = mapsketch::loadSketch(sketch_path);
+  mapsketch::RouteParams rp;
+  applyConfig(rp, o.config, "route");
+  const mapsketch::Route route = mapsketch::toRoute(sketch, rp);
+
+  // --- landmark model -------------------------------------------------------------------------
+  std::string model_path = o.model;
+  landmarks::ModelParams mp;
+  applyConfig(mp, o.config, "landmarks.train");
+  auto model = std::make_shared<landmarks::LandmarkModel>();
+  if (!model_path.empty()) {
+    *model = landmarks::LandmarkModel::load(model_path);
+  } else {
+    const std::string dir = o.landmark_dir.empty() ? resourcePath("landmarks") : o.landmark_dir;
+    model_path = modelCachePath(dir, o.cache_dir);
+    const bool cached = fs::exists(model_path);
+    if (o.progress && !cached)
+      std::cerr << "training the landmark model from " << dir << " (first use; cached in "
+                << model_path << ")\n";
+    int last_pct = -1;
+    *model = landmarks::loadOrTrainModel(
+        dir, model_path, mp, [&](const std::string& stage, int done, int total) {
+          const int pct = total > 0 ? 100 * done / total : 0;
+          if (o.progress && pct / 25 != last_pct / 25)
+            std::cerr << "  " << stage << " " << done << "/" << total << "\n";
+          last_pct = pct;
+        });
+  }
+  mapsketch::validateClasses(sketch, model->classes(), sketch_path);
+
+  // --- settings -----------------------------------------------------------------------------
+  nav::NavSettings settings = nav::navSettingsFrom(o.config);
+  nav::PerceptionParams pp;
+  if (simr) {
+    // The simulated robot's geometry, unless the user overrides it.
+    const auto& w = simr->world();
+    if (!o.config.has("servo.camera_x_m")) settings.servo.camera_x_m = w.camera.x;
+    if (!o.config.has("servo.camera_z_m")) settings.servo.camera_z_m = w.camera.z;
+    if (!o.config.has("nav.avoid.robot_radius_m")) settings.avoid.robot_radius_m = w.robot.radius;
+    if (!o.config.has("nav.camera_period_s") && simr->params().camera_hz > 0)
+      settings.exec.camera_period_s = 1.0 / simr->params().camera_hz;
+    pp.camera_yaw = w.camera.yaw;
+  }
+  if (o.max_time_s > 0) settings.exec.max_time_s = o.max_time_s;
+  settings.exec.validate();
+  settings.servo.validate();
+  settings.avoid.validate();
+  applyConfig(pp, o.config, "nav.perception");
+
+  if (!o.out_dir.empty()) fs::create_directories(o.out_dir);
+  RunObserver observer(o.out_dir, o.progress, simr.get(), static_cast<int>(route.sections.size()));
+  nav::LandmarkPerception perception(model, pp);
+  nav::Devices dev;
+  dev.camera = camera.get();
+  dev.base = base.get();
+  if (laser) dev.ranges.push_back(laser.get());
+  if (sonar) dev.ranges.push_back(sonar.get());
+  dev.clock = ctx.clock.get();
+
+  const auto w0 = wall::now();
+  nav::ExecutiveSummary es;
+  {
+    nav::Executive ex(route, dev, perception, settings, &observer);
+    es = ex.run();
+  }
+  const double wall_s = std::chrono::duration<double>(wall::now() - w0).count();
+
+  // --- summary ------------------------------------------------------------------------------
+  Json s;
+  bool success = es.status == nav::RunStatus::Succeeded;
+  std::string reason = es.reason;
+  s["mode"] = hardware ? "hardware" : "sim";
+  s["time_s"] = es.time_s;
+  s["wall_time_s"] = wall_s;
+  s["real_time_factor"] = wall_s > 0 ? es.time_s / wall_s : 0.0;
+  s["odom_path_m"] = es.odom_path_m;
+  s["path_length_m"] = es.odom_path_m;
+  s["seed"] = o.seed;
+  s["world"] = hardware ? "" : world_name;
+  s["sketch"] = sketch_path;
+  s["model"] = model_path;
+  Json recognised = Json::array();
+  for (const auto& l : es.landmarks)
+    if (l.frames_seen > 0) recognised.push_back(l.id);
+  s["landmarks_recognised"] = recognised;
+  s["landmarks_expected"] = es.landmarks.size();
+  const Json ej = es.toJson();
+  s["landmarks"] = ej["landmarks"];
+  s["sections_done"] = es.sections_done;
+  s["sections"] = es.sections;
+  s["avoidance_manoeuvres"] = es.avoidance_manoeuvres;
+  s["perception"] = {{"frames", es.frames},
+                     {"frames_processed", es.frames_processed},
+                     {"mean_ms", es.perception_ms_mean},
+                     {"max_ms", es.perception_ms_max},
+                     {"objectness_ms", es.objectness_ms_mean},
+                     {"features_ms", es.features_ms_mean},
+                     {"match_ms", es.match_ms_mean}};
+  s["executive"] = {{"status", nav::toString(es.status)}, {"reason", es.reason}};
+  s["settings"] = {{"nav", paramsToJson(settings.exec)},
+                   {"servo", paramsToJson(settings.servo)},
+                   {"avoid", paramsToJson(settings.avoid)},
+                   {"safety", paramsToJson(settings.safety)},
+                   {"perception", paramsToJson(pp)}};
+  s["min_clearance_m"] = nullptr;
+  s["deviation_m"] = nullptr;
+
+  RouteToWorld r2w;
+  r2w.route_start = route.start_m;
+  r2w.rot = -route.start_heading_rad;
+  std::vector<hw::Pose2D> traj;
+  if (simr) {
+    simr->sync();
+    const auto& w = simr->world();
+    r2w.start = w.start;
+    for (const auto& t : simr->trajectory()) traj.push_back(t.truth);
+    traj.push_back(simr->truePose());
+    const bool collided = simr->collided();
+    const bool at_goal = simr->atGoal();
+    const auto tp = simr->truePose();
+    const double to_goal = std::hypot(tp.x - w.goal.centre.x(), tp.y - w.goal.centre.y());
+    s["collided"] = collided;
+    if (collided) s["collision_with"] = simr->collisionWith();
+    s["at_goal"] = at_goal;
+    s["distance_to_goal_m"] = to_goal;
+    s["min_clearance_m"] = simr->minClearance();
+    s["path_length_m"] = simr->stats().distance;
+    s["frames_rendered"] = simr->stats().frames_rendered;
+    s["render_s"] = simr->stats().render_seconds;
+    // Ground truth decides success in simulation: the executive's belief is not enough.
+    if (collided) {
+      success = false;
+      reason =
+          "collision with " + simr->collisionWith() + (es.reason.empty() ? "" : "; " + es.reason);
+    } else if (success && !at_goal) {
+      success = false;
+      char b[160];
+      std::snprintf(b, sizeof b, "route completed but the robot stopped %.2f m from the goal",
+                    to_goal);
+      reason = b;
+    } else if (success) {
+      reason = "reached the goal";
+    }
+  } else {
+    traj = observer.odom;
+  }
+  // Deviation of the actual trajectory from the sketched path (in the world / odometry frame).
+  std::vector<Eigen::Vector2d> sketched;
+  for (const auto& g : route.guide_points_m) sketched.push_back(r2w(g));
+  if (!traj.empty()) {
+    double sum = 0, mx = 0;
+    for (const auto& p : traj) {
+      const double d = distToPolyline({p.x, p.y}, sketched);
+      sum += d;
+      mx = std::max(mx, d);
+    }
+    s["deviation_m"] = {{"mean", sum / traj.size()}, {"max", mx}};
+  }
+  s["success"] = success;
+  s["reason"] = reason;
+
+  if (!o.out_dir.empty()) {
+    std::ofstream(o.out_dir + "/summary.json") << s.dump(2) << "\n";
+    if (simr) {
+      drawTrajectory(o.out_dir + "/trajectory.png", simr->world(), sketch, route, r2w, traj);
+    } else {
+      // No world map on a real robot: an empty floor around the sketch and the odometry.
+      sim::World w;
+      double x0 = 1e9, y0 = 1e9, x1 = -1e9, y1 = -1e9;
+      auto grow = [&](double x, double y) {
+        x0 = std::min(x0, x), y0 = std::min(y0, y), x1 = std::max(x1, x), y1 = std::max(y1, y);
+      };
+      for (const auto& p : sketched) grow(p.x(), p.y());
+      for (const auto& p : traj) grow(p.x, p.y);
+      w.floor = {{x0 - 1, y0 - 1}, {x1 + 1, y0 - 1}, {x1 + 1, y1 + 1}, {x0 - 1, y1 + 1}};
+      w.goal.centre = sketched.back();
+      drawTrajectory(o.out_dir + "/trajectory.png", w, sketch, route, r2w, traj);
+    }
+    s["out_dir"] = o.out_dir;
+  }
+  return s;
+}
+
+}  // namespace sketchnav::app

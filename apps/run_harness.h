@@ -1,0 +1,40 @@
+#pragma once
+// `sketchnav run` as a function, shared by the command and the closed-loop integration tests:
+// opens the devices (the simulator by default, or hardware URIs), loads the sketch -> route
+// and the landmark model (trained on first use and cached), runs the navigation executive and
+// writes summary.json, trajectory.png, events.jsonl and telemetry.csv.
+#include <functional>
+#include <memory>
+#include <string>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/hw/devices.h"
+
+namespace sketchnav::app {
+
+struct RunOptions {
+  std::string world = "lab";  // sim: a world name in share/worlds or a world file
+  std::string sketch;         // default: share/sketches/<world>.sketch.json
+  std::string model;          // a .slm file; default: trained from landmark_dir and cached
+  std::string landmark_dir;   // default: share/landmarks
+  std::string cache_dir;      // model cache; default $XDG_CACHE_HOME/sketchnav or ~/.cache/...
+  int seed = 1;
+  bool realtime = false;
+  double max_time_s = 0;  // > 0 overrides nav.max_time_s
+  std::string out_dir;    // "" = write no files
+  // Hardware: any of these set -> a real robot (each empty one is absent).
+  std::string robot, camera, laser, sonar;
+  Config config;         // --config / --set (nav.*, servo.*, sim.*, ...)
+  bool progress = true;  // progress lines on stderr
+  /// Test hook: wraps the camera (e.g. to drop it mid-run). Never used by the command.
+  std::function<std::unique_ptr<hw::Camera>(std::unique_ptr<hw::Camera>)> wrap_camera;
+};
+
+/// Runs one navigation. Returns the summary object (what summary.json holds). Throws
+/// InputError for bad options / files, RuntimeError when a device cannot be opened.
+Json runNavigation(const RunOptions& options);
+
+/// The landmark model cache file for a landmark set folder (keyed by its content hash).
+std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir);
+
+}  // namespace sketchnav::app

@@ -1,0 +1,181 @@
+#pragma once
+// The navigation executive: follows a route section by section on odometry, looks for each
+// section's expected landmark, servos on it (servo::TurnLaw) and judges its distance with the
+// range sensors, avoids obstacles (ObstacleAvoider) and stops on any fault (SafetySupervisor).
+//
+// Lifecycle: configure (constructor) -> start() -> step() at the clock's pace until done()
+// -> stop(). run() is that loop: clock->sleepUntil(next tick), step(). Time is the Clock's, so
+// the same code runs the simulator (as fast as the CPU allows) and the real robot.
+// The executive owns none of the devices; they must outlive it.
+#include <nlohmann/json.hpp>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/hw/clock.h"
+#include "sketchnav/hw/devices.h"
+#include "sketchnav/mapsketch/route.h"
+#include "sketchnav/nav/avoidance.h"
+#include "sketchnav/nav/landmark_stage.h"
+#include "sketchnav/nav/perception.h"
+#include "sketchnav/nav/safety.h"
+#include "sketchnav/nav/sections.h"
+#include "sketchnav/servo/turn_law.h"
+
+namespace sketchnav::nav {
+
+struct ExecutiveParams {
+  double tick_s = 0.05;              // [s] control period
+  double camera_period_s = 0.1;      // [s] expected frame period (frames are grabbed at this pace)
+  double v_cruise = 0.30;            // [m/s] forward speed along the route
+  double k_heading = 1.2;            // [1/s] path following: yaw rate per rad of bearing error
+  double max_w = 0.8;                // [rad/s]
+  double turn_in_place_deg = 60;     // [deg] bearing error above which the robot turns on the spot
+  double max_time_s = 900;           // [s] whole run
+  double section_time_factor = 4;    // a section taking longer than factor * length / v
+  double section_time_extra_s = 40;  // + extra seconds has failed ("no progress")
+  // Landmark stage
+  double approach_m = 1.4;      // [m] a servoed landmark is passed at max(this, its range_m)
+                                // (more than avoid.trigger_m + radius: pass before dodging)
+  double max_approach_m = 2.5;  // [m] cap on the sketch's range_m for that test
+  double servo_hold_s = 0.5;    // [s] keep the last servo command this long between frames
+  double lost_after_s = 2.0;    // [s] a tracked landmark unseen this long: back to searching
+  double miss_slack_m = 2.0;    // [m] past a landmark's along position without seeing it: missed
+  double reanchor_gain = 0.8;   // how much a passed landmark re-anchors the route (0 = never)
+  double end_blocked_m = 1.0;   // [m] dodging this close to a section's end point, with an
+                                // obstacle at or before it, ends the section
+  double realign_gain = 0.8;    // how much it re-rotates the route about the previous fix
+  double realign_baseline_m = 2.0;   // [m] minimum fix-to-landmark distance for that
+  double perception_period_s = 0.2;  // [s] frames given to perception at most this often
+  double attend_bearing_deg = 75;    // [deg] look for the landmark only when the sketch puts it
+  double attend_range_m = 12;        // [m]  within this bearing and range
+  int max_missed_in_row = 2;         // more consecutive missed landmarks than this: lost, fail
+  double goal_stop_s = 0.5;          // [s] settle time at the goal
+  template <class B>
+  void bind(B& b) {
+    b("tick_s", tick_s);
+    b("camera_period_s", camera_period_s);
+    b("v_cruise", v_cruise);
+    b("k_heading", k_heading);
+    b("max_w", max_w);
+    b("turn_in_place_deg", turn_in_place_deg);
+    b("max_time_s", max_time_s);
+    b("section_time_factor", section_time_factor);
+    b("section_time_extra_s", section_time_extra_s);
+    b("approach_m", approach_m);
+    b("max_approach_m", max_approach_m);
+    b("servo_hold_s", servo_hold_s);
+    b("lost_after_s", lost_after_s);
+    b("miss_slack_m", miss_slack_m);
+    b("reanchor_gain", reanchor_gain);
+    b("end_blocked_m", end_blocked_m);
+    b("realign_gain", realign_gain);
+    b("realign_baseline_m", realign_baseline_m);
+    b("perception_period_s", perception_period_s);
+    b("attend_bearing_deg", attend_bearing_deg);
+    b("attend_range_m", attend_range_m);
+    b("max_missed_in_row", max_missed_in_row);
+    b("goal_stop_s", goal_stop_s);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+/// Every setting of a run, loadable from a Config ("nav.*", "nav.sections.*", "servo.*"...).
+struct NavSettings {
+  ExecutiveParams exec;
+  SectionParams sections;
+  SelectParams select;
+  AvoidParams avoid;
+  SafetyParams safety;
+  servo::TurnLawParams servo;
+};
+
+/// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*",
+/// "nav.avoid.*", "nav.safety.*", "servo.*") over the defaults and validates.
+NavSettings navSettingsFrom(const Config& config);
+
+/// One control tick, for telemetry.csv.
+struct TelemetryRow {
+  double t = 0;
+  hw::Pose2D odom;
+  double v_cmd = 0, w_cmd = 0;
+  double servo_error = 0;  // x_t - x_d when servoing, NaN otherwise
+  std::string mode;        // follow | servo | avoid | stopped | done | failed
+  std::string turn;        // Left | Straight | Right
+  int section = 0;
+  std::string landmark;     // id of the attended landmark ("" when none)
+  double front_free_m = 0;  // free corridor ahead
+};
+
+class ExecutiveObserver {
+ public:
+  virtual ~ExecutiveObserver() = default;
+  virtual void onEvent(const nlohmann::json& event) {}
+  virtual void onTick(const TelemetryRow& row) {}
+};
+
+enum class RunStatus { Idle, Running, Succeeded, Failed };
+
+struct LandmarkReport {
+  std::string id, class_name;
+  int section = 0;
+  std::string state;  // pending | tracking | passed | missed
+  int frames_seen = 0;
+  int max_inliers = 0;
+};
+
+struct ExecutiveSummary {
+  RunStatus status = RunStatus::Idle;
+  std::string reason;
+  double time_s = 0;       // [s] on the run's clock
+  double odom_path_m = 0;  // distance travelled by odometry
+  int sections_done = 0, sections = 0;
+  std::vector<LandmarkReport> landmarks;
+  int frames = 0;            // camera frames grabbed
+  int frames_processed = 0;  // frames given to perception
+  double perception_ms_mean = 0, perception_ms_max = 0;
+  double objectness_ms_mean = 0, features_ms_mean = 0, match_ms_mean = 0;
+  int avoidance_manoeuvres = 0;
+  nlohmann::json toJson() const;
+};
+
+struct Devices {
+  hw::Camera* camera = nullptr;
+  hw::Base* base = nullptr;
+  std::vector<hw::RangeSensor*> ranges;  // laser and / or sonar
+  hw::Clock* clock = nullptr;
+};
+
+class Executive {
+ public:
+  /// Configure. Throws InputError for invalid settings or an empty route.
+  Executive(mapsketch::Route route, Devices devices, Perception& perception,
+            NavSettings settings = {}, ExecutiveObserver* observer = nullptr);
+  ~Executive();
+  Executive(const Executive&) = delete;
+  Executive& operator=(const Executive&) = delete;
+
+  void start();
+  /// One control tick at the clock's current time. Never throws: any exception stops the
+  /// base and fails the run.
+  void step();
+  /// Stops the base (idempotent). A run stopped while Running is Failed with `reason`.
+  void stop(const std::string& reason = "stopped");
+  bool done() const;
+  /// start(); loop { clock->sleepUntil(next tick); step(); } until done(); returns summary().
+  ExecutiveSummary run();
+
+  ExecutiveSummary summary() const;
+  const SectionTracker& sections() const;
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+const char* toString(RunStatus s);
+
+}  // namespace sketchnav::nav

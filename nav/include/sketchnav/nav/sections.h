@@ -1,0 +1,93 @@
+#pragma once
+// Path-section bookkeeping: the route (mapsketch::Route, in the route frame) placed in the
+// odometry frame, the current section, progress along it, and the point to steer to.
+//
+// Alignment: the odometry frame is the robot's start frame. At start the robot is assumed to
+// stand at the route's start facing `start_heading_rad`, so oMr (route -> odometry) is the
+// rotation by -start_heading about the start point. When a landmark is recognised at a place
+// that disagrees with the sketch, reanchor() shifts oMr (never rotates it: one bearing does
+// not fix a heading), so the rest of the route is followed relative to that landmark.
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "sketchnav/hw/types.h"
+#include "sketchnav/mapsketch/route.h"
+
+namespace sketchnav::nav {
+
+double wrapAngle(double a);  // to (-pi, pi]
+
+struct SectionParams {
+  double reach_radius_m = 0.35;  // [m] a section ends when its end point is this close...
+  double end_slack_m = 0.10;     // [m] ...or the robot has crossed the line through its end
+                                 // point (perpendicular to it) to within this
+  double lookahead_m = 1.0;      // [m] pure-pursuit look-ahead along the remaining route
+  template <class B>
+  void bind(B& b) {
+    b("reach_radius_m", reach_radius_m);
+    b("end_slack_m", end_slack_m);
+    b("lookahead_m", lookahead_m);
+  }
+  void validate() const;  // InputError "nav.sections.<field> = ...: ..."
+};
+
+struct SectionProgress {
+  double along_m = 0;      // distance travelled along the current section (projection)
+  double cross_m = 0;      // signed lateral offset from it (left positive)
+  double remaining_m = 0;  // to its end point along the section
+  double to_end_m = 0;     // straight-line distance to its end point
+};
+
+class SectionTracker {
+ public:
+  /// Throws InputError when the route has no section.
+  SectionTracker(mapsketch::Route route, SectionParams params = {});
+
+  const mapsketch::Route& route() const { return route_; }
+  int current() const { return current_; }
+  int count() const { return static_cast<int>(route_.sections.size()); }
+  bool finished() const { return current_ >= count(); }
+  /// The current section (precondition: !finished()).
+  const mapsketch::PathSection& section() const;
+
+  Eigen::Vector2d toOdom(const Eigen::Vector2d& route_pt) const;
+  Eigen::Vector2d toRoute(const Eigen::Vector2d& odom_pt) const;
+  double headingToOdom(double route_heading) const;
+  /// Shifts the alignment by `gain` (0..1) of the way so that `route_pt` maps to `odom_pt`.
+  void reanchor(const Eigen::Vector2d& route_pt, const Eigen::Vector2d& odom_pt, double gain);
+  /// Rotates the alignment about a trusted fix (`anchor_route` seen at `anchor_odom`: the
+  /// start, or the previous landmark) by `gain` of the angle between where the sketch puts
+  /// `route_pt` and where it was seen (`odom_pt`), when both are at least `min_baseline_m`
+  /// from the anchor. This is what corrects a start heading that differs from the first
+  /// section's direction. Returns the rotation applied [rad].
+  double realign(const Eigen::Vector2d& route_pt, const Eigen::Vector2d& odom_pt,
+                 const Eigen::Vector2d& anchor_route, const Eigen::Vector2d& anchor_odom,
+                 double gain, double min_baseline_m = 1.5);
+
+  SectionProgress progress(const hw::Pose2D& odom) const;
+  /// Advances past every section whose end has been reached; returns how many it advanced.
+  int update(const hw::Pose2D& odom);
+  /// Moves to the next section unconditionally (e.g. its landmark was passed at its end).
+  void advance();
+  /// The point (odometry frame) `lookahead_m` ahead of the robot's projection on the
+  /// remaining route (continuing into the following sections, clamped at the goal).
+  Eigen::Vector2d lookahead(const hw::Pose2D& odom) const;
+  /// The sketched route (guide points) in the odometry frame.
+  std::vector<Eigen::Vector2d> guidePointsOdom() const;
+
+ private:
+  mapsketch::Route route_;
+  SectionParams params_;
+  int current_ = 0;
+  double rot_ = 0;               // odom heading = route heading + rot_
+  Eigen::Vector2d trans_{0, 0};  // odom = R(rot_) (route - start) + trans_
+};
+
+/// Bearing [rad, CCW, robot frame] and range [m] of an odometry-frame point from a pose.
+struct Polar {
+  double bearing = 0, range = 0;
+};
+Polar polarFrom(const hw::Pose2D& pose, const Eigen::Vector2d& pt);
+
+}  // namespace sketchnav::nav

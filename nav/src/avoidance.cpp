@@ -1,0 +1,280 @@
+#include "sketchnav/nav/avoidance.h"
+
+#include <mrpt/math/TPoint2D.h>
+#include <mrpt/nav/holonomic/CHolonomicND.h>
+
+#include <algorithm>
+#include <cmath>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/nav/sections.h"
+
+namespace sketchnav::nav {
+
+const char* toString(DodgeSide s) {
+  switch (s) {
+    case DodgeSide::Left:
+      return "left";
+    case DodgeSide::Right:
+      return "right";
+    default:
+      return "none";
+  }
+}
+
+void AvoidParams::validate() const {
+  require(robot_radius_m > 0 && robot_radius_m < 2, "nav.avoid.robot_radius_m",
+          "must be in (0, 2) m");
+  require(trigger_m > 0, "nav.avoid.trigger_m", "must be > 0");
+  require(release_m >= trigger_m, "nav.avoid.release_m", "must be >= trigger_m");
+  require(corridor_margin_m >= 0, "nav.avoid.corridor_margin_m", "must be >= 0");
+  require(min_clearance_m >= 0 && min_clearance_m < trigger_m, "nav.avoid.min_clearance_m",
+          "must be in [0, trigger_m)");
+  require(slow_m > min_clearance_m, "nav.avoid.slow_m", "must be > min_clearance_m");
+  require(max_range_m > trigger_m, "nav.avoid.max_range_m", "must be > trigger_m");
+  require(side_bias_deg >= 0 && side_bias_deg < 90, "nav.avoid.side_bias_deg",
+          "must be in [0, 90)");
+  require(min_active_s >= 0, "nav.avoid.min_active_s", "must be >= 0");
+  require(k_heading > 0, "nav.avoid.k_heading", "must be > 0");
+  require(sectors >= 36 && sectors <= 1440, "nav.avoid.sectors", "must be in [36, 1440]");
+}
+
+std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans) {
+  std::vector<std::pair<double, double>> pts;
+  for (const auto& s : scans) {
+    const size_t n = std::min(s.angles.size(), s.ranges.size());
+    for (size_t i = 0; i < n; ++i) {
+      const double r = s.ranges[i];
+      if (!std::isfinite(r) || r >= s.max_range || r < s.min_range) continue;
+      const double a = s.angles[i];
+      // A sonar only says "something within the cone at r": put points across the cone.
+      const double half = s.kind == hw::RangeScan::Kind::Sonar ? 0.5 * s.beam_width : 0.0;
+      for (double da : half > 0 ? std::vector<double>{-half, 0.0, half} : std::vector<double>{0.0})
+        pts.emplace_back(s.mount.x + r * std::cos(a + da), s.mount.y + r * std::sin(a + da));
+    }
+  }
+  return pts;
+}
+
+double corridorFree(const std::vector<std::pair<double, double>>& pts, double direction,
+                    double half_width, double max_len) {
+  const double c = std::cos(direction), s = std::sin(direction);
+  double best = max_len;
+  for (const auto& [x, y] : pts) {
+    const double fwd = c * x + s * y, lat = -s * x + c * y;
+    if (std::abs(lat) >= half_width) continue;
+    if (fwd < -half_width) continue;
+    const double touch = fwd - std::sqrt(half_width * half_width - lat * lat);
+    best = std::min(best, std::max(0.0, touch));
+  }
+  return best;
+}
+
+struct ObstacleAvoider::Impl {
+  mrpt::nav::CHolonomicND nd;
+};
+
+ObstacleAvoider::ObstacleAvoider(AvoidParams params) : params_(params) {
+  params_.validate();
+  impl_ = std::make_unique<Impl>();
+  impl_->nd.enableApproachTargetSlowDown(false);
+}
+ObstacleAvoider::~ObstacleAvoider() = default;
+ObstacleAvoider::ObstacleAvoider(ObstacleAvoider&&) noexcept = default;
+ObstacleAvoider& ObstacleAvoider::operator=(ObstacleAvoider&&) noexcept = default;
+
+void ObstacleAvoider::reset() {
+  active_ = false;
+  side_ = DodgeSide::None;
+}
+
+double ObstacleAvoider::capSpeed(const std::vector<hw::RangeScan>& scans, double v) const {
+  const auto pts = scanPoints(scans);
+  const double free = corridorFree(pts, 0.0, params_.robot_radius_m + params_.corridor_margin_m,
+                                   params_.max_range_m);
+  if (free <= params_.min_clearance_m) return 0.0;
+  const double k = std::clamp(
+      (free - params_.min_clearance_m) / (params_.slow_m - params_.min_clearance_m), 0.0, 1.0);
+  return v * std::max(k, 0.25 * (free > params_.min_clearance_m + 0.05));
+}
+
+AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, double target_bearing,
+                                  DodgeSide landmark_side, double heading, double v_nominal,
+                                  double now) {
+  const auto& P = params_;
+  const auto pts = scanPoints(scans);
+  const double hw = P.robot_radius_m + P.corridor_margin_m;
+  AvoidOutput out;
+  out.front_free_m = corridorFree(pts, 0.0, hw, P.max_range_m);
+  out.clearance_m = P.max_range_m;
+  for (const auto& [x, y] : pts)
+    out.clearance_m = std::min(out.clearance_m, std::hypot(x, y) - P.robot_radius_m);
+  // How fast is the thing ahead coming towards us, beyond our own motion? (A static obstacle:
+  // ~0; a pedestrian walking at us: its speed.) Filtered over scans.
+  // Only on a new scan, and only while driving straight: when the robot turns, "ahead" is
+  // another obstacle; between scans the reading has not changed.
+  double stamp = -1;
+  for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
+  const bool fresh = stamp > prev_stamp_ + 1e-9;
+  const bool straight = std::abs(wrapAngle(heading - prev_heading_)) < 0.05;
+  if (fresh) {
+    if (!straight) {
+      approach_ *= 0.5;
+    } else if (prev_free_ >= 0 && stamp > prev_t_ + 1e-6 &&
+               out.front_free_m < P.max_range_m - 0.05 && prev_free_ < P.max_range_m - 0.05) {
+      const double rate = (prev_free_ - out.front_free_m) / (stamp - prev_t_) - prev_v_;
+      if (std::abs(rate) < 2.0) approach_ = 0.6 * approach_ + 0.4 * rate;
+    } else if (out.front_free_m >= P.max_range_m - 0.05) {
+      approach_ = 0;
+    }
+    prev_heading_ = heading;
+    prev_stamp_ = stamp;
+  }
+  if (fresh) {
+    prev_free_ = out.front_free_m;
+    prev_t_ = stamp;
+  }
+  out.approach_speed = approach_;
+  const double moving = approach_ > 0.25 ? approach_ : 0.0;
+  const double trigger = std::min(P.trigger_m + moving * P.approach_horizon_s, P.max_range_m - 0.3);
+  const double toward = std::clamp(target_bearing, -0.6, 0.6);
+  const double target_free = corridorFree(pts, toward, hw, P.max_range_m);
+
+  if (!active_) {
+    if (std::min(out.front_free_m, target_free) >= trigger) {
+      prev_v_ = v_nominal;
+      return out;
+    }
+    // Start a manoeuvre: remember where we were going and which side the landmark is on.
+    active_ = true;
+    have_prev_ = false;
+    out.started = true;
+    since_ = now;
+    original_heading_ = heading;
+    auto room = [&](double sgn) {
+      return corridorFree(pts, sgn * 0.5, hw, P.max_range_m) +
+             corridorFree(pts, sgn * 1.0, hw, P.max_range_m);
+    };
+    const double left = room(+1), right = room(-1);
+    side_ = landmark_side;
+    if (side_ == DodgeSide::None) side_ = left >= right ? DodgeSide::Left : DodgeSide::Right;
+    // The landmark's side is preferred unless it is closed while the other is open.
+    const double mine = side_ == DodgeSide::Left ? left : right;
+    const double other = side_ == DodgeSide::Left ? right : left;
+    if (mine < 2 * P.trigger_m && other > 2 * mine)
+      side_ = side_ == DodgeSide::Left ? DodgeSide::Right : DodgeSide::Left;
+  } else if (now - since_ >= P.min_active_s && target_free >= std::max(P.release_m, trigger) &&
+             corridorFree(pts, target_bearing, hw, P.max_range_m) >= P.trigger_m) {
+    active_ = false;
+    prev_v_ = v_nominal;
+    out.ended = true;
+    out.side = side_;
+    out.original_heading = original_heading_;
+    side_ = DodgeSide::None;
+    return out;
+  }
+  out.active = true;
+  out.side = side_;
+  out.original_heading = original_heading_;
+
+  // Configuration-space polar diagram for MRPT's ND: for each direction, how far the robot's
+  // centre can travel before its disc touches an obstacle point, normalised by max_range.
+  const int N = P.sectors;
+  std::vector<double> obst(N, 1.0);
+  const double R = P.robot_radius_m;
+  for (const auto& [x, y] : pts) {
+    const double d = std::hypot(x, y);
+    if (d - R >= P.max_range_m) continue;
+    const double phi = std::atan2(y, x);
+    const double half = d <= R ? M_PI : std::asin(R / d);
+    const int span = static_cast<int>(std::ceil(half / (2 * M_PI / N))) + 1;
+    const int k0 = static_cast<int>(std::floor((phi + M_PI) / (2 * M_PI) * N));
+    for (int dk = -span; dk <= span; ++dk) {
+      const int k = ((k0 + dk) % N + N) % N;
+      const double alpha = M_PI * (-1.0 + 2.0 * (k + 0.5) / N);
+      const double delta = wrapAngle(alpha - phi);
+      double t;
+      if (d <= R) {
+        t = 0;
+      } else {
+        const double ls = d * std::sin(delta);
+        if (std::abs(ls) > R || std::cos(delta) <= 0) continue;
+        t = std::max(0.0, d * std::cos(delta) - std::sqrt(R * R - ls * ls));
+      }
+      obst[k] = std::min(obst[k], t / P.max_range_m);
+    }
+  }
+  const double sgn = side_ == DodgeSide::Left ? 1.0 : -1.0;
+  const double bias = sgn * P.side_bias_deg * M_PI / 180;
+  const double tb = wrapAngle(target_bearing + bias);
+  mrpt::nav::CAbstractHolonomicReactiveMethod::NavInput ni;
+  ni.obstacles = obst;
+  ni.targets.emplace_back(0.9 * std::cos(tb), 0.9 * std::sin(tb));
+  ni.maxRobotSpeed = 1.0;
+  ni.maxObstacleDist = 1.0;
+  mrpt::nav::CAbstractHolonomicReactiveMethod::NavOutput no;
+  impl_->nd.navigate(ni, no);
+  double dir = wrapAngle(no.desiredDirection);
+
+  // ND knows nothing of the chosen side and can flip between gaps from one scan to the next.
+  // Its direction is kept only when it is open and does not cross to the other side of the
+  // route direction; otherwise the first open direction is searched from the route direction
+  // towards the chosen side (then the other side): a stable tangent around the obstacle.
+  const double open_m = P.trigger_m;
+  auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= open_m; };
+  const double rel = wrapAngle(dir - target_bearing) * sgn;  // > 0: on the chosen side
+  const bool nd_ok = no.desiredSpeed > 0.05 && open(dir) && rel > -0.35 && std::abs(dir) < 2.0;
+  bool found = nd_ok;
+  // Hysteresis: a direction chosen before (kept in the odometry frame) that is still open is
+  // kept, so the robot does not swing between two gaps while the target bearing moves.
+  if (!found && have_prev_) {
+    const double a = wrapAngle(prev_dir_odom_ - heading);
+    if (std::abs(a) <= 2.2 && open(a)) {
+      dir = a;
+      found = true;
+    }
+  }
+  if (!found) {
+    const double step = 5 * M_PI / 180;
+    for (int pass = 0; pass < 2 && !found; ++pass) {
+      const double s2 = pass == 0 ? sgn : -sgn;
+      for (double off = 0; off <= 150 * M_PI / 180 && !found; off += step) {
+        const double a = wrapAngle(target_bearing + s2 * off);
+        if (std::abs(a) <= 2.2 && open(a)) {
+          dir = a;
+          found = true;
+        }
+      }
+    }
+  }
+  double speed = 1.0;
+  if (!found) {  // boxed in: turn on the spot towards the chosen side
+    dir = sgn * 1.2;
+    speed = 0;
+    have_prev_ = false;
+  } else {
+    prev_dir_odom_ = wrapAngle(heading + dir);
+    have_prev_ = true;
+  }
+  out.direction = dir;
+  out.w = P.k_heading * dir;
+  double v = v_nominal * speed * std::max(0.0, std::cos(dir));
+  if (std::abs(dir) > 1.0) v = 0;  // turn first, then go
+  // Slow down as the corridor ahead closes, down to the minimum clearance.
+  v *=
+      std::clamp((out.front_free_m - P.min_clearance_m) / (P.slow_m - P.min_clearance_m), 0.0, 1.0);
+  if (out.front_free_m <= P.min_clearance_m) {
+    v = 0;
+    out.blocked = true;
+  }
+  // Something keeps coming at us while we cannot go forward: back off (the way we came is
+  // normally free) rather than wait to be walked into.
+  if (moving > 0 && out.front_free_m <= P.min_clearance_m + 0.25 &&
+      corridorFree(pts, M_PI, hw, P.max_range_m) > 0.5)
+    v = -P.reverse_speed;
+  out.v = v;
+  prev_v_ = v;
+  return out;
+}
+
+}  // namespace sketchnav::nav

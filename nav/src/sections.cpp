@@ -1,0 +1,141 @@
+#include "sketchnav/nav/sections.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/core/error.h"
+
+namespace sketchnav::nav {
+
+double wrapAngle(double a) {
+  a = std::fmod(a + M_PI, 2 * M_PI);
+  if (a <= 0) a += 2 * M_PI;
+  return a - M_PI;
+}
+
+void SectionParams::validate() const {
+  require(reach_radius_m > 0 && reach_radius_m < 5, "nav.sections.reach_radius_m",
+          "must be in (0, 5) m");
+  require(end_slack_m >= 0 && end_slack_m < 5, "nav.sections.end_slack_m", "must be in [0, 5) m");
+  require(lookahead_m > 0.1 && lookahead_m < 10, "nav.sections.lookahead_m",
+          "must be in (0.1, 10) m");
+}
+
+namespace {
+Eigen::Vector2d rot(double a, const Eigen::Vector2d& v) {
+  const double c = std::cos(a), s = std::sin(a);
+  return {c * v.x() - s * v.y(), s * v.x() + c * v.y()};
+}
+}  // namespace
+
+SectionTracker::SectionTracker(mapsketch::Route route, SectionParams params)
+    : route_(std::move(route)), params_(params) {
+  params_.validate();
+  if (route_.sections.empty()) throw InputError("route: no path section to follow");
+  rot_ = -route_.start_heading_rad;
+}
+
+const mapsketch::PathSection& SectionTracker::section() const {
+  if (finished()) throw std::logic_error("SectionTracker::section() after the last section");
+  return route_.sections[current_];
+}
+
+Eigen::Vector2d SectionTracker::toOdom(const Eigen::Vector2d& p) const {
+  return rot(rot_, p - route_.start_m) + trans_;
+}
+Eigen::Vector2d SectionTracker::toRoute(const Eigen::Vector2d& p) const {
+  return rot(-rot_, p - trans_) + route_.start_m;
+}
+double SectionTracker::headingToOdom(double h) const {
+  return wrapAngle(h + rot_);
+}
+
+void SectionTracker::reanchor(const Eigen::Vector2d& route_pt, const Eigen::Vector2d& odom_pt,
+                              double gain) {
+  trans_ += gain * (odom_pt - toOdom(route_pt));
+}
+
+double SectionTracker::realign(const Eigen::Vector2d& route_pt, const Eigen::Vector2d& odom_pt,
+                               const Eigen::Vector2d& anchor_route,
+                               const Eigen::Vector2d& anchor_odom, double gain,
+                               double min_baseline_m) {
+  const Eigen::Vector2d predicted = toOdom(route_pt) - toOdom(anchor_route);
+  const Eigen::Vector2d seen = odom_pt - anchor_odom;
+  if (predicted.norm() < min_baseline_m || seen.norm() < min_baseline_m) return 0;
+  const double delta =
+      gain * wrapAngle(std::atan2(seen.y(), seen.x()) - std::atan2(predicted.y(), predicted.x()));
+  // Rotate about the anchor: it must map to anchor_odom before and after.
+  rot_ += delta;
+  trans_ = anchor_odom - rot(rot_, anchor_route - route_.start_m);
+  return delta;
+}
+
+SectionProgress SectionTracker::progress(const hw::Pose2D& o) const {
+  SectionProgress p;
+  if (finished()) return p;
+  const auto& s = section();
+  const Eigen::Vector2d a = toOdom(s.start_m), b = toOdom(s.end_m), r(o.x, o.y);
+  Eigen::Vector2d d = b - a;
+  const double len = d.norm();
+  if (len > 1e-9) d /= len;
+  p.along_m = (r - a).dot(d);
+  p.cross_m = d.x() * (r - a).y() - d.y() * (r - a).x();
+  p.remaining_m = len - p.along_m;
+  p.to_end_m = (b - r).norm();
+  return p;
+}
+
+int SectionTracker::update(const hw::Pose2D& o) {
+  int n = 0;
+  while (!finished()) {
+    const auto p = progress(o);
+    // Reached its end point, or crossed the line through the end point (perpendicular to the
+    // section): a robot pushed sideways by a dodge must not circle back to the exact point.
+    if (p.to_end_m > params_.reach_radius_m && p.remaining_m > params_.end_slack_m) break;
+    ++current_;
+    ++n;
+  }
+  return n;
+}
+
+void SectionTracker::advance() {
+  if (!finished()) ++current_;
+}
+
+std::vector<Eigen::Vector2d> SectionTracker::guidePointsOdom() const {
+  std::vector<Eigen::Vector2d> out;
+  for (const auto& g : route_.guide_points_m) out.push_back(toOdom(g));
+  return out;
+}
+
+Eigen::Vector2d SectionTracker::lookahead(const hw::Pose2D& o) const {
+  const auto pts = guidePointsOdom();
+  if (finished()) return pts.back();
+  const int k = current_;
+  const Eigen::Vector2d a = pts[k], b = pts[k + 1], r(o.x, o.y);
+  const Eigen::Vector2d d = b - a;
+  const double len = d.norm();
+  const double t = len > 1e-9 ? std::clamp((r - a).dot(d) / len, 0.0, len) : 0.0;
+  // Pure pursuit: the first point of the remaining route, from the robot's projection on,
+  // that is at least `lookahead` away from the robot (so the target never sits on top of a
+  // robot that is off the line, e.g. after a dodge).
+  Eigen::Vector2d p = len > 1e-9 ? Eigen::Vector2d(a + d / len * t) : a;
+  const double step = 0.05;
+  for (int i = k; i + 1 < static_cast<int>(pts.size()); ++i) {
+    const Eigen::Vector2d seg_end = pts[i + 1];
+    while ((seg_end - p).norm() > 1e-9) {
+      if ((p - r).norm() >= params_.lookahead_m) return p;
+      const Eigen::Vector2d dir = seg_end - p;
+      p = dir.norm() <= step ? seg_end : Eigen::Vector2d(p + dir.normalized() * step);
+    }
+  }
+  return pts.back();
+}
+
+Polar polarFrom(const hw::Pose2D& pose, const Eigen::Vector2d& pt) {
+  const Eigen::Vector2d d = pt - Eigen::Vector2d(pose.x, pose.y);
+  return {wrapAngle(std::atan2(d.y(), d.x()) - pose.theta), d.norm()};
+}
+
+}  // namespace sketchnav::nav

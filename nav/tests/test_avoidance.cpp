@@ -1,0 +1,117 @@
+// Obstacle avoidance over laser + sonar: trigger, rotation direction from the landmark's
+// side, the other side when that one is closed, minimum clearance, corridor geometry.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/nav/avoidance.h"
+
+using namespace sketchnav;
+using namespace sketchnav::nav;
+
+namespace {
+// A laser scan (robot frame, mount at the origin) of circles and straight walls y = const.
+struct Disc {
+  double x, y, r;
+};
+hw::RangeScan laser(const std::vector<Disc>& discs, std::vector<double> wall_y = {}) {
+  hw::RangeScan s;
+  s.kind = hw::RangeScan::Kind::Laser;
+  s.min_range = 0.05f;
+  s.max_range = 8.0f;
+  for (int i = -120; i <= 120; ++i) {
+    const double a = i * M_PI / 180, c = std::cos(a), sn = std::sin(a);
+    double best = 8.0;
+    for (const auto& d : discs) {
+      const double b = d.x * c + d.y * sn, disc = b * b - (d.x * d.x + d.y * d.y - d.r * d.r);
+      if (disc >= 0 && b - std::sqrt(disc) > 0) best = std::min(best, b - std::sqrt(disc));
+    }
+    for (double wy : wall_y)
+      if (sn * wy > 1e-9) best = std::min(best, wy / sn);
+    s.angles.push_back(static_cast<float>(a));
+    s.ranges.push_back(static_cast<float>(best));
+  }
+  return s;
+}
+}  // namespace
+
+TEST(Corridor, FreeLengthOfAStraightCorridor) {
+  const std::vector<std::pair<double, double>> pts{{2.0, 0.0}, {1.0, 0.5}, {-1, 0}};
+  EXPECT_NEAR(corridorFree(pts, 0.0, 0.3, 5.0), 1.7, 1e-9);
+  EXPECT_NEAR(corridorFree(pts, M_PI, 0.3, 5.0), 0.7, 1e-9);
+  EXPECT_NEAR(corridorFree({}, 0.0, 0.3, 5.0), 5.0, 1e-9);
+}
+
+TEST(ScanPoints, SonarConesAreConservative) {
+  hw::RangeScan s;
+  s.kind = hw::RangeScan::Kind::Sonar;
+  s.max_range = 4;
+  s.beam_width = 0.4;
+  s.angles = {0.0f, 1.0f};
+  s.ranges = {1.0f, 4.0f};  // the second sees nothing
+  s.mount = {0.1, 0, 0};
+  const auto pts = scanPoints({s});
+  ASSERT_EQ(pts.size(), 3u);
+  EXPECT_NEAR(pts[1].first, 1.1, 1e-6);
+}
+
+TEST(Avoider, IdleWhenTheWayIsFree) {
+  ObstacleAvoider a;
+  const auto out = a.step({laser({{5, 2, 0.3}})}, 0.0, DodgeSide::Left, 0.0, 0.3, 0.0);
+  EXPECT_FALSE(out.active);
+  EXPECT_FALSE(a.active());
+  EXPECT_NEAR(a.capSpeed({laser({})}, 0.3), 0.3, 1e-12);
+}
+
+TEST(Avoider, DodgesTowardsTheLandmarkSide) {
+  for (auto side : {DodgeSide::Left, DodgeSide::Right}) {
+    ObstacleAvoider a;
+    const auto out = a.step({laser({{0.8, 0.0, 0.3}})}, 0.0, side, 0.7, 0.3, 0.0);
+    ASSERT_TRUE(out.active);
+    EXPECT_TRUE(out.started);
+    EXPECT_EQ(out.side, side);
+    EXPECT_NEAR(out.original_heading, 0.7, 1e-12);
+    if (side == DodgeSide::Left)
+      EXPECT_GT(out.w, 0.1);
+    else
+      EXPECT_LT(out.w, -0.1);
+  }
+}
+
+TEST(Avoider, TakesTheOtherSideWhenTheLandmarkSideIsClosed) {
+  // Obstacle ahead, a wall 0.45 m to the left: dodging left is impossible.
+  ObstacleAvoider a;
+  const auto out = a.step({laser({{0.8, 0.0, 0.3}}, {0.45})}, 0.0, DodgeSide::Left, 0.0, 0.3, 0.0);
+  ASSERT_TRUE(out.active);
+  EXPECT_EQ(out.side, DodgeSide::Right);
+  EXPECT_LT(out.w, 0);
+}
+
+TEST(Avoider, NeverMovesForwardInsideTheMinimumClearance) {
+  ObstacleAvoider a;
+  const auto scan = laser({{0.35, 0.0, 0.1}});  // 0.05 m from the body
+  const auto out = a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.3, 0.0);
+  EXPECT_TRUE(out.active);
+  EXPECT_EQ(out.v, 0.0);
+  EXPECT_TRUE(out.blocked);
+  EXPECT_EQ(a.capSpeed({scan}, 0.3), 0.0);
+}
+
+TEST(Avoider, EndsWhenTheRouteIsClearAgainAfterTheHoldTime) {
+  AvoidParams p;
+  p.min_active_s = 1.0;
+  ObstacleAvoider a(p);
+  ASSERT_TRUE(a.step({laser({{0.8, 0, 0.3}})}, 0.0, DodgeSide::Left, 0, 0.3, 0.0).active);
+  // The obstacle is now behind-right: still held during the hold time, then released.
+  EXPECT_TRUE(a.step({laser({{-0.5, -0.6, 0.3}})}, 0.0, DodgeSide::Left, 0, 0.3, 0.5).active);
+  const auto out = a.step({laser({{-0.5, -0.6, 0.3}})}, 0.0, DodgeSide::Left, 0, 0.3, 1.2);
+  EXPECT_FALSE(out.active);
+  EXPECT_TRUE(out.ended);
+}
+
+TEST(AvoidParams, ValidateNamesTheField) {
+  AvoidParams p;
+  p.release_m = 0.1;
+  EXPECT_THROW(p.validate(), InputError);
+}

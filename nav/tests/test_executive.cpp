@@ -1,0 +1,157 @@
+// The executive in closed loop on fake devices (a unicycle on a SimClock, a laser over
+// discs, a geometric test-only perception): reaches the end with landmarks, without one,
+// fails "lost" when landmarks keep missing, avoids a disc on the path, and stops within
+// 200 ms on a dropped camera, a lost link or an exception.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+
+#include "fake_world.h"
+#include "route_util.h"
+#include "sketchnav/nav/executive.h"
+
+using namespace sketchnav;
+using namespace sketchnav::nav;
+using namespace sketchnav::nav::test;
+
+namespace {
+
+struct Recorder : ExecutiveObserver {
+  std::vector<nlohmann::json> events;
+  double min_clearance = 1e9;
+  FakeWorld* w = nullptr;
+  void onEvent(const nlohmann::json& e) override { events.push_back(e); }
+  void onTick(const TelemetryRow& r) override {
+    min_clearance = std::min(min_clearance, w->clearance());
+    if (std::getenv("NAV_TEST_TRACE") && static_cast<int>(r.t * 20) % 10 == 0)
+      std::printf("t=%.1f x=%.2f y=%.2f th=%.2f v=%.2f w=%.2f %s sec=%d lm=%s free=%.2f\n", r.t,
+                  r.odom.x, r.odom.y, r.odom.theta, r.v_cmd, r.w_cmd, r.mode.c_str(), r.section,
+                  r.landmark.c_str(), r.front_free_m);
+  }
+  int count(const std::string& type) const {
+    int n = 0;
+    for (const auto& e : events) n += e["type"] == type;
+    return n;
+  }
+};
+
+struct Scenario {
+  FakeWorld world;
+  FakeBase base{world};
+  FakeLaser laser{world};
+  std::unique_ptr<FakeCamera> camera;
+  std::unique_ptr<GeometricPerception> perception;
+  Recorder rec;
+  mapsketch::Route route;
+  NavSettings settings;
+
+  // Sketch: (0,0) -> (6,0) -> (6,5); landmark A near the corner, B beyond the goal. The
+  // real landmarks stand 0.3-0.4 m away from where the sketch put them.
+  Scenario(bool see_a = true, bool see_b = true, double drop_camera = 1e9) {
+    route = makeRoute({{0, 0}, {6, 0}, {6, 5}},
+                      {{0, "A", "cup", {7.0, 0.3}}, {1, "B", "bin", {6.4, 6.2}}});
+    world.obstacles = {{{7.3, 0.5}, 0.15}, {{6.6, 6.5}, 0.15}};
+    std::vector<TrueMark> marks;
+    if (see_a) marks.push_back({"cup", {7.3, 0.5}});
+    if (see_b) marks.push_back({"bin", {6.6, 6.5}});
+    camera = std::make_unique<FakeCamera>(world, drop_camera);
+    perception = std::make_unique<GeometricPerception>(world, marks);
+    rec.w = &world;
+    settings.exec.max_time_s = 120;
+  }
+  ExecutiveSummary run() {
+    Executive ex(route, {camera.get(), &base, {&laser}, world.clock.get()}, *perception, settings,
+                 &rec);
+    return ex.run();
+  }
+  double distToGoal() const { return std::hypot(world.truth.x - 6, world.truth.y - 5); }
+};
+
+}  // namespace
+
+TEST(Executive, ReachesTheEndWithLandmarks) {
+  Scenario s;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_LT(s.distToGoal(), 0.6);
+  EXPECT_EQ(s.rec.count("landmark_passed"), 2);
+  EXPECT_EQ(s.rec.count("landmark_missed"), 0);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+  ASSERT_EQ(sum.landmarks.size(), 2u);
+  EXPECT_EQ(sum.landmarks[0].state, "passed");
+  EXPECT_GT(sum.frames_processed, 10);
+  EXPECT_TRUE(s.world.stopped_called);
+}
+
+TEST(Executive, ReachesTheEndWithOneLandmarkMissing) {
+  Scenario s(/*see_a=*/false, /*see_b=*/true);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_LT(s.distToGoal(), 0.6);
+  EXPECT_EQ(s.rec.count("landmark_missed"), 1);
+  EXPECT_EQ(sum.landmarks[0].state, "missed");
+  EXPECT_EQ(sum.landmarks[1].state, "passed");
+}
+
+TEST(Executive, FailsWithAReasonWhenLandmarksKeepMissing) {
+  Scenario s(false, false);
+  s.settings.exec.max_missed_in_row = 1;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Failed);
+  EXPECT_NE(sum.reason.find("lost"), std::string::npos) << sum.reason;
+  EXPECT_NE(sum.reason.find("A, B"), std::string::npos) << sum.reason;
+  EXPECT_EQ(s.world.v, 0.0);
+}
+
+TEST(Executive, AvoidsAStaticObstacleOnThePath) {
+  Scenario s;
+  s.world.obstacles.push_back({{3.0, 0.05}, 0.35});
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_GE(sum.avoidance_manoeuvres, 1);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+  EXPECT_LT(s.distToGoal(), 0.6);
+}
+
+TEST(Executive, StopsWithin200msOfADroppedCamera) {
+  Scenario s(true, true, /*drop_camera=*/3.0);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Failed);
+  EXPECT_NE(sum.reason.find("camera"), std::string::npos) << sum.reason;
+  ASSERT_TRUE(s.world.stopped_called);
+  // The last frame came at <= 3.0 s: the stop must follow within 200 ms of the data going stale.
+  EXPECT_LE(s.world.last_stop_t, 3.0 + s.settings.safety.camera_timeout_s + 0.2);
+  EXPECT_LT(s.world.last_motion_cmd_t, s.world.last_stop_t + 1e-9);
+  EXPECT_EQ(s.world.v, 0.0);
+  EXPECT_EQ(s.rec.count("fault"), 1);
+}
+
+TEST(Executive, StopsOnAnException) {
+  Scenario s;
+  s.perception->throw_now = true;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Failed);
+  EXPECT_NE(sum.reason.find("exception"), std::string::npos) << sum.reason;
+  EXPECT_TRUE(s.world.stopped_called);
+  EXPECT_EQ(s.world.v, 0.0);
+  EXPECT_LT(s.world.clock->now(), 0.5);
+}
+
+TEST(Executive, StopsOnALostBaseLink) {
+  Scenario s;
+  Executive ex(s.route, {s.camera.get(), &s.base, {&s.laser}, s.world.clock.get()}, *s.perception,
+               s.settings, &s.rec);
+  ex.start();
+  double t = 0;
+  for (int i = 0; i < 40; ++i) s.world.clock->sleepUntil(t += 0.05), ex.step();
+  EXPECT_GT(s.world.v, 0.0);
+  s.world.link_ok = false;
+  s.world.clock->sleepUntil(t += 0.05);
+  ex.step();
+  EXPECT_TRUE(ex.done());
+  EXPECT_EQ(ex.summary().status, RunStatus::Failed);
+  EXPECT_EQ(s.world.v, 0.0);
+  EXPECT_NEAR(s.world.last_stop_t, t, 1e-9);
+}

@@ -1,0 +1,127 @@
+// Section bookkeeping and landmark disambiguation.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "route_util.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/nav/landmark_stage.h"
+#include "sketchnav/nav/sections.h"
+
+using namespace sketchnav;
+using namespace sketchnav::nav;
+using sketchnav::nav::test::makeRoute;
+
+TEST(SectionTracker, AlignsTheRouteWithTheStartFrame) {
+  // Route drawn going "up" the canvas from (2, 3): the robot's start frame has it along +x.
+  SectionTracker t(makeRoute({{2, 3}, {2, 7}, {5, 7}}));
+  const Eigen::Vector2d a = t.toOdom({2, 7});
+  EXPECT_NEAR(a.x(), 4, 1e-9);
+  EXPECT_NEAR(a.y(), 0, 1e-9);
+  const Eigen::Vector2d b = t.toOdom({5, 7});  // a right turn in the route -> y < 0 in odom
+  EXPECT_NEAR(b.x(), 4, 1e-9);
+  EXPECT_NEAR(b.y(), -3, 1e-9);
+  EXPECT_NEAR((t.toRoute(b) - Eigen::Vector2d(5, 7)).norm(), 0, 1e-9);
+  EXPECT_NEAR(t.headingToOdom(M_PI / 2), 0, 1e-9);
+}
+
+TEST(SectionTracker, ProgressAndAdvance) {
+  SectionTracker t(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
+  hw::Pose2D p{1, 0.5, 0};
+  auto pr = t.progress(p);
+  EXPECT_NEAR(pr.along_m, 1, 1e-9);
+  EXPECT_NEAR(pr.cross_m, 0.5, 1e-9);
+  EXPECT_NEAR(pr.remaining_m, 3, 1e-9);
+  EXPECT_EQ(t.update(p), 0);
+  EXPECT_EQ(t.current(), 0);
+  EXPECT_EQ(t.update({3.8, 0.1, 0}), 1);  // within the reach radius of (4, 0)
+  EXPECT_EQ(t.current(), 1);
+  EXPECT_EQ(t.update({4.1, 1.0, 1.57}), 0);
+  EXPECT_EQ(t.update({4.0, 3.4, 1.57}), 1);  // overshot the end: past it counts
+  EXPECT_TRUE(t.finished());
+  SectionTracker t2(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
+  EXPECT_EQ(t2.update({3.95, 1.2, 0}), 1);  // 1.2 m off to the side but across the end line
+}
+
+TEST(SectionTracker, LookaheadCutsIntoTheNextSection) {
+  SectionParams sp;
+  sp.lookahead_m = 1.0;
+  SectionTracker t(makeRoute({{0, 0}, {4, 0}, {4, 3}}), sp);
+  const auto la = t.lookahead({3.5, 0, 0});
+  EXPECT_NEAR(la.x(), 4, 1e-9);  // 1 m from the robot, on the next section
+  EXPECT_GE(la.y(), std::sqrt(0.75) - 1e-9);
+  EXPECT_LE(la.y(), std::sqrt(0.75) + 0.06);
+  // A robot pushed 1 m sideways near the corner still gets a target 1 m away, never on top.
+  const auto off = t.lookahead({3.9, 1.0, 0});
+  EXPECT_GE((off - Eigen::Vector2d(3.9, 1.0)).norm(), 1.0 - 1e-9);
+  SectionTracker t2(makeRoute({{0, 0}, {4, 0}, {4, 3}}), sp);
+  t2.update({4.0, 0.0, 0});
+  ASSERT_EQ(t2.current(), 1);
+  EXPECT_NEAR(t2.lookahead({4.0, 2.5, 0}).y(), 3.0, 1e-9);  // clamped at the goal
+}
+
+TEST(SectionTracker, ReanchorShiftsButNeverRotates) {
+  SectionTracker t(makeRoute({{0, 0}, {4, 0}}));
+  t.reanchor({4, 1}, {4.5, 1.2}, 1.0);
+  EXPECT_NEAR((t.toOdom({4, 1}) - Eigen::Vector2d(4.5, 1.2)).norm(), 0, 1e-9);
+  EXPECT_NEAR((t.toOdom({0, 0}) - Eigen::Vector2d(0.5, 0.2)).norm(), 0, 1e-9);
+  t.reanchor({0, 0}, {0, 0}, 0.5);
+  EXPECT_NEAR((t.toOdom({0, 0}) - Eigen::Vector2d(0.25, 0.1)).norm(), 0, 1e-9);
+}
+
+TEST(SectionTracker, EmptyRouteIsBadInput) {
+  EXPECT_THROW(SectionTracker(mapsketch::Route{}), InputError);
+}
+
+TEST(Polar, BearingIsCcwInTheRobotFrame) {
+  const auto p = polarFrom({1, 1, M_PI / 2}, {0, 1});
+  EXPECT_NEAR(p.bearing, M_PI / 2, 1e-9);
+  EXPECT_NEAR(p.range, 1, 1e-9);
+  EXPECT_NEAR(wrapAngle(3 * M_PI), M_PI, 1e-9);
+}
+
+namespace {
+Detection det(const std::string& cls, double bearing_deg, int inliers = 20) {
+  Detection d;
+  d.class_name = cls;
+  d.bearing = bearing_deg * M_PI / 180;
+  d.inliers = inliers;
+  return d;
+}
+}  // namespace
+
+TEST(SelectCandidate, PicksTheSameClassLandmarkThePredictionPointsAt) {
+  // Three bins: the one predicted 10 deg left at 3 m is the second.
+  const Detection a = det("bin", 25), b = det("bin", 12), c = det("bin", -20), m = det("milk", 10);
+  const std::vector<Candidate> cands{{&a, 2.0}, {&m, 3.0}, {&b, 3.2}, {&c, 2.9}};
+  SelectParams p;
+  EXPECT_EQ(selectCandidate(cands, "bin", 10 * M_PI / 180, 3.0, p), 2);
+  // The range disambiguates when bearings are alike.
+  const Detection d1 = det("bin", 5), d2 = det("bin", 6);
+  EXPECT_EQ(selectCandidate({{&d1, 6.0}, {&d2, 2.5}}, "bin", 5.5 * M_PI / 180, 2.4, p), 1);
+}
+
+TEST(SelectCandidate, RejectsDetectionsInconsistentWithTheSketch) {
+  const Detection far = det("bin", -60), ok = det("bin", 0);
+  SelectParams p;
+  EXPECT_EQ(selectCandidate({{&far, 2.0}}, "bin", 0.0, 2.0, p), -1);
+  EXPECT_EQ(selectCandidate({{&ok, 9.0}}, "bin", 0.0, 2.0, p), -1);  // 7 m off in range
+  EXPECT_EQ(selectCandidate({{&ok, 0.0}}, "bin", 0.0, 2.0, p), 0);   // no range: bearing only
+  EXPECT_EQ(selectCandidate({{&ok, 2.0}}, "cup", 0.0, 2.0, p), -1);
+}
+
+TEST(SectionTracker, RealignCorrectsAWrongStartHeading) {
+  // The robot really started 25 deg right of the first section: a landmark the sketch puts
+  // 4 m straight ahead is seen 25 deg to the right. Realigning about the start fixes the
+  // remaining route.
+  SectionTracker t(makeRoute({{0, 0}, {6, 0}, {6, 4}}));
+  const double e = -25 * M_PI / 180;
+  // In the robot's (odometry) frame the true world is rotated by -e.
+  const Eigen::Vector2d seen(4 * std::cos(-e), 4 * std::sin(-e));
+  const double d = t.realign({4, 0}, seen, {0, 0}, {0, 0}, 1.0);
+  EXPECT_NEAR(d, -e, 1e-9);
+  EXPECT_NEAR((t.toOdom({4, 0}) - seen).norm(), 0, 1e-9);
+  EXPECT_NEAR(t.toOdom({0, 0}).norm(), 0, 1e-9);  // the anchor stays put
+  // Too short a baseline: no rotation.
+  EXPECT_EQ(t.realign({0.5, 0}, {0.4, 0.3}, {0, 0}, {0, 0}, 1.0), 0.0);
+}

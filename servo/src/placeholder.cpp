@@ -1,1 +1,0 @@
-// Replaced by the servo law (issue #7).
