@@ -16,7 +16,7 @@ PACKAGES=(
   build-essential cmake pkg-config ccache git
   libopencv-dev libopencv-contrib-dev libeigen3-dev libvisp-dev libmrpt-dev
   libaravis-dev aravis-tools libusb-1.0-0-dev
-  nlohmann-json3-dev libcpp-httplib-dev
+  nlohmann-json3-dev libcpp-httplib-dev libssl-dev zlib1g-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   visp-images-data mrpt-common
   chromium

@@ -32,6 +32,11 @@ sketchnav_require(PKG_CONFIG_FOUND "pkg-config" "pkg-config")
 pkg_check_modules(ARAVIS QUIET IMPORTED_TARGET aravis-0.8)
 sketchnav_require(ARAVIS_FOUND "Aravis 0.8" "libaravis-dev libusb-1.0-0-dev")
 
+find_package(ZLIB QUIET)
+sketchnav_require(ZLIB_FOUND "zlib" "zlib1g-dev")
+find_package(OpenSSL QUIET COMPONENTS Crypto)
+sketchnav_require(OPENSSL_FOUND "OpenSSL (libcrypto)" "libssl-dev")
+
 find_path(HTTPLIB_INCLUDE_DIR httplib.h)
 if(HTTPLIB_INCLUDE_DIR)
   set(HTTPLIB_FOUND TRUE)
