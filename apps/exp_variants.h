@@ -1,0 +1,53 @@
+#pragma once
+// The paper's experiments 2-4 as simulated scenarios, generated from the lab world
+// (share/worlds/lab.world.json) by documented transformations (doc/experiments.md), plus a
+// hand-drawn-like sketch made per seeded trial (sketch noise). Odometry noise comes from the
+// simulator's own seeded odometry model. Names are stable so reports stay comparable.
+#include <Eigen/Core>
+
+#include <cstdint>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/config.h"
+
+namespace sketchnav::app {
+
+/// One experiment variant: the world it runs in and the guide line the user draws.
+struct Variant {
+  std::string name;
+  std::string description;
+  Json world;                               // world-file JSON (share/worlds format)
+  std::vector<Eigen::Vector2d> drawn_path;  // [m] world frame: the guide line as intended
+  std::vector<std::string> sketched;        // landmark ids the user puts on the sketch
+};
+
+/// How inaccurate the generated sketches are (per trial, seeded).
+struct SketchNoise {
+  double landmark_sigma_m = 0.25;  // [m] error of where a landmark box is drawn
+  double distance_sigma = 0.10;    // relative (log-normal) error of each distance estimate
+  double distance_round_m = 0.5;   // [m] people round distances
+  double path_sigma_m = 0.15;      // [m] error of each guide-line corner
+  double jitter_px = 1.0;          // [px] hand jitter of each drawn point
+  template <class B>
+  void bind(B& b) {
+    b("landmark_sigma_m", landmark_sigma_m);
+    b("distance_sigma", distance_sigma);
+    b("distance_round_m", distance_round_m);
+    b("path_sigma_m", path_sigma_m);
+    b("jitter_px", jitter_px);
+  }
+  void validate() const;
+};
+
+/// The 13 variant names, in report order.
+const std::vector<std::string>& variantNames();
+
+/// Builds a variant; InputError naming the unknown variant and the known ones.
+Variant makeVariant(const std::string& name);
+
+/// A sketch (.sketch.json content) of `v` as a person would draw it; `seed` draws the noise.
+/// Canvas 1000 x 720 px, u = 32 + 52 x, v = 698 - 52 y (like share/sketches/lab.sketch.json).
+Json makeSketch(const Variant& v, const SketchNoise& noise, std::uint64_t seed);
+
+}  // namespace sketchnav::app

@@ -1,0 +1,7 @@
+# Sources the experiments work (issue #8: replay, tune, experiments) adds to the sketchnav
+# executable. scenario.cpp uses the run harness (apps/nav.cmake: sketchnav_runharness).
+target_sources(sketchnav PRIVATE
+  ${CMAKE_CURRENT_SOURCE_DIR}/exp_variants.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/scenario.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/plot.cpp)
+target_link_libraries(sketchnav PRIVATE opencv_imgproc opencv_imgcodecs opencv_videoio)

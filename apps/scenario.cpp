@@ -1,0 +1,216 @@
+#include "scenario.h"
+
+#include <fcntl.h>
+#include <signal.h>
+#include <sys/prctl.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <fstream>
+#include <iostream>
+#include <mutex>
+#include <sstream>
+#include <thread>
+
+#include "run_harness.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/paths.h"
+#include "sketchnav/landmarks/model.h"
+
+namespace sketchnav::app {
+namespace fs = std::filesystem;
+
+std::string selfExecutable() {
+  std::error_code ec;
+  const auto p = fs::read_symlink("/proc/self/exe", ec);
+  if (ec) throw RuntimeError("cannot find the running executable (/proc/self/exe)");
+  return p.string();
+}
+
+std::string ensureModel(const std::string& model, bool progress) {
+  if (!model.empty()) {
+    if (!fs::exists(model)) throw InputError("--model " + model + ": no such file");
+    return model;
+  }
+  const std::string dir = resourcePath("landmarks");
+  const std::string path = modelCachePath(dir, "");
+  if (!fs::exists(path)) {
+    if (progress)
+      std::cerr << "training the landmark model from " << dir << " (cached in " << path << ")\n";
+    landmarks::ModelParams mp;
+    landmarks::loadOrTrainModel(dir, path, mp, {});
+  }
+  return path;
+}
+
+namespace {
+
+std::vector<std::string> splitCsv(const std::string& line) {
+  std::vector<std::string> out;
+  std::string cell;
+  std::istringstream in(line);
+  while (std::getline(in, cell, ',')) out.push_back(cell);
+  if (!line.empty() && line.back() == ',') out.push_back("");
+  return out;
+}
+
+double num(const std::vector<std::string>& row, int i) {
+  if (i < 0 || i >= static_cast<int>(row.size()) || row[i].empty()) return NAN;
+  try {
+    return std::stod(row[i]);
+  } catch (...) {
+    return NAN;
+  }
+}
+
+double jnum(const Json& j, const char* key, double def = 0) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : def;
+}
+
+// Runs one child; returns its exit status (-1 when it could not start).
+int spawnRun(const ScenarioSpec& s, const std::string& exe) {
+  std::vector<std::string> args = {exe,           "--json",     "run",
+                                   "--world",     s.world_file, "--sketch",
+                                   s.sketch_file, "--seed",     std::to_string(s.seed),
+                                   "--out",       s.out_dir,    "--model",
+                                   s.model};
+  if (!s.config_file.empty()) args.insert(args.begin() + 1, {"--config", s.config_file});
+  for (const auto& kv : s.sets) args.insert(args.begin() + 1, {"--set", kv});
+  if (s.max_time_s > 0) {
+    std::ostringstream t;
+    t << s.max_time_s;
+    args.insert(args.end(), {"--max-time", t.str()});
+  }
+  std::vector<char*> argv;
+  for (auto& a : args) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  const std::string out = s.out_dir + "/stdout.json", err = s.out_dir + "/run.log";
+  // fork + exec rather than posix_spawn: the child asks to be killed when this process dies
+  // (Ctrl-C or a kill of `experiments` must not leave runs behind). Only async-signal-safe
+  // calls between fork and exec.
+  const pid_t pid = fork();
+  if (pid < 0) return -1;
+  if (pid == 0) {
+    prctl(PR_SET_PDEATHSIG, SIGTERM);
+    const int fo = open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    const int fe = open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+    if (fo >= 0) dup2(fo, 1);
+    if (fe >= 0) dup2(fe, 2);
+    execv(exe.c_str(), argv.data());
+    _exit(127);
+  }
+  int status = 0;
+  while (waitpid(pid, &status, 0) < 0 && errno == EINTR) {
+  }
+  return WIFEXITED(status) ? WEXITSTATUS(status)
+                           : 128 + (WIFSIGNALED(status) ? WTERMSIG(status) : 0);
+}
+
+std::string lastLine(const std::string& file) {
+  std::ifstream in(file);
+  std::string line, last;
+  while (std::getline(in, line))
+    if (!line.empty()) last = line;
+  return last;
+}
+
+}  // namespace
+
+ScenarioResult readRunFolder(const std::string& dir) {
+  ScenarioResult r;
+  std::ifstream sj(dir + "/summary.json");
+  if (!sj) {
+    r.reason = "no summary: " + lastLine(dir + "/run.log");
+    return r;
+  }
+  try {
+    r.summary = Json::parse(sj);
+  } catch (const std::exception& e) {
+    r.reason = std::string("unreadable summary.json: ") + e.what();
+    return r;
+  }
+  const Json& s = r.summary;
+  r.ran = true;
+  r.success = s.value("success", false);
+  r.reason = s.value("reason", "");
+  r.time_s = jnum(s, "time_s");
+  r.path_m = jnum(s, "path_length_m");
+  r.min_clearance_m = jnum(s, "min_clearance_m", NAN);
+  r.wall_s = jnum(s, "wall_time_s");
+  if (s.contains("deviation_m") && s["deviation_m"].is_object()) {
+    r.deviation_mean_m = jnum(s["deviation_m"], "mean", NAN);
+    r.deviation_max_m = jnum(s["deviation_m"], "max", NAN);
+  }
+  // Telemetry: the true poses and the commanded yaw rate.
+  std::ifstream tc(dir + "/telemetry.csv");
+  std::string line;
+  if (tc && std::getline(tc, line)) {
+    const auto head = splitCsv(line);
+    auto col = [&](const std::string& n) {
+      for (size_t i = 0; i < head.size(); ++i)
+        if (head[i] == n) return static_cast<int>(i);
+      return -1;
+    };
+    const int cx = col("true_x"), cy = col("true_y"), ct = col("true_theta"), cw = col("w_cmd");
+    int last_sign = 0, changes = 0;
+    while (std::getline(tc, line)) {
+      const auto row = splitCsv(line);
+      const double x = num(row, cx), y = num(row, cy), th = num(row, ct), w = num(row, cw);
+      if (std::isfinite(x) && std::isfinite(y))
+        r.trajectory.push_back({x, y, std::isfinite(th) ? th : 0.0});
+      // A sign change counts when |w| is clearly non-zero on both sides (1e-3 rad/s), so
+      // going straight between two turns the same way is not an oscillation.
+      if (std::isfinite(w) && std::abs(w) > 1e-3) {
+        const int sg = w > 0 ? 1 : -1;
+        if (last_sign != 0 && sg != last_sign) ++changes;
+        last_sign = sg;
+      }
+    }
+    r.oscillation_per_m = r.path_m > 0.1 ? changes / r.path_m : 0.0;
+  }
+  return r;
+}
+
+std::vector<ScenarioResult> runScenarios(const std::vector<ScenarioSpec>& specs, int jobs,
+                                         bool progress) {
+  const std::string exe = selfExecutable();
+  std::vector<ScenarioResult> results(specs.size());
+  std::atomic<size_t> next{0};
+  std::atomic<int> done{0};
+  std::mutex io;
+  auto worker = [&] {
+    for (size_t i = next++; i < specs.size(); i = next++) {
+      const auto& s = specs[i];
+      fs::create_directories(s.out_dir);
+      const auto t0 = std::chrono::steady_clock::now();
+      const int rc = spawnRun(s, exe);
+      results[i] = readRunFolder(s.out_dir);
+      if (rc < 0)
+        results[i].reason = "could not start " + exe;
+      else if (!results[i].ran && rc >= 128)
+        results[i].reason = "run crashed (status " + std::to_string(rc) + ")";
+      const double wall =
+          std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+      if (progress) {
+        std::lock_guard<std::mutex> lk(io);
+        char buf[400];
+        std::snprintf(buf, sizeof buf, "[%d/%zu] %-28s %-7s %6.1f s sim, %5.1f s wall: %s\n",
+                      ++done, specs.size(), s.label.c_str(),
+                      results[i].success ? "success" : "FAILED", results[i].time_s, wall,
+                      results[i].reason.c_str());
+        std::cerr << buf << std::flush;
+      }
+    }
+  };
+  std::vector<std::thread> pool;
+  const int n = std::max(1, std::min<int>(jobs, static_cast<int>(specs.size())));
+  for (int k = 0; k < n; ++k) pool.emplace_back(worker);
+  for (auto& t : pool) t.join();
+  return results;
+}
+
+}  // namespace sketchnav::app

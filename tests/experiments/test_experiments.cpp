@@ -1,0 +1,115 @@
+// Unit tests of the experiment variants (issue #8): every variant yields a world the simulator
+// loads and a sketch the route builder accepts, with the transformation it promises, and the
+// sketch noise is seeded.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <map>
+#include <set>
+
+#include "exp_variants.h"
+#include "plot.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/paths.h"
+#include "sketchnav/mapsketch/io.h"
+#include "sketchnav/mapsketch/route.h"
+#include "sketchnav/sim/world.h"
+
+namespace sketchnav::app {
+namespace {
+
+int landmarkCount(const Variant& v) {
+  return static_cast<int>(v.world["landmarks"].size());
+}
+
+TEST(ExperimentVariants, ThirteenStableNames) {
+  const auto& n = variantNames();
+  ASSERT_EQ(n.size(), 13u);
+  EXPECT_EQ(std::set<std::string>(n.begin(), n.end()).size(), 13u);
+  EXPECT_EQ(n.front(), "exp2-moved-a");
+  EXPECT_EQ(n.back(), "exp4-pedestrian-right");
+  EXPECT_THROW(makeVariant("exp5"), InputError);
+}
+
+TEST(ExperimentVariants, EveryVariantLoadsAndRoutes) {
+  for (const auto& name : variantNames()) {
+    SCOPED_TRACE(name);
+    const Variant v = makeVariant(name);
+    const sim::World w = sim::worldFromJson(v.world, name, resourceDir());
+    EXPECT_EQ(static_cast<int>(w.landmarks.size()), landmarkCount(v));
+    const Json sj = makeSketch(v, SketchNoise{}, 3);
+    const mapsketch::Sketch s = mapsketch::sketchFromJson(sj, name);
+    EXPECT_EQ(s.landmarks.size(), v.sketched.size());
+    const mapsketch::Route r = mapsketch::toRoute(s);
+    EXPECT_GE(r.sections.size(), 3u);
+    // The route's scale comes from the distances: 52 px per metre within the noise.
+    EXPECT_NEAR(r.scale_m_per_px * 52.0, 1.0, 0.25);
+    // The robot is put down facing along the first stroke.
+    const auto d0 = v.drawn_path[1] - v.drawn_path[0];
+    EXPECT_NEAR(w.start.theta, std::atan2(d0.y(), d0.x()), 1e-6);
+  }
+}
+
+TEST(ExperimentVariants, TransformationsAsDocumented) {
+  EXPECT_EQ(landmarkCount(makeVariant("exp3-8")), 8);
+  EXPECT_EQ(landmarkCount(makeVariant("exp3-6")), 6);
+  EXPECT_EQ(landmarkCount(makeVariant("exp3-4")), 4);
+  const Variant uneven = makeVariant("exp3-4-uneven");
+  ASSERT_EQ(landmarkCount(uneven), 4);
+  for (const auto& l : uneven.world["landmarks"])  // all in room A (x < 8 m)
+    EXPECT_LT(l["position"][0].get<double>(), 8.0);
+  for (const char* name : {"exp4-repeated-a", "exp4-repeated-b"}) {
+    std::map<std::string, int> per_class;
+    const Variant v = makeVariant(name);  // (not a temporary: the loop refers into it)
+    for (const auto& l : v.world["landmarks"]) ++per_class[l["class"].get<std::string>()];
+    int max_same = 0;
+    for (const auto& [c, n] : per_class) max_same = std::max(max_same, n);
+    EXPECT_EQ(max_same, 3) << name;
+    EXPECT_EQ(landmarkCount(makeVariant(name)), 8);
+  }
+  const Variant ped = makeVariant("exp4-pedestrian-left");
+  const auto& p = ped.world["pedestrians"].back();
+  EXPECT_DOUBLE_EQ(p["speed"].get<double>(), 0.4);
+  EXPECT_GT(p["path"][0][1].get<double>(), 6.3);  // left of the line (heading +x: y larger)
+  EXPECT_LT(
+      makeVariant("exp4-pedestrian-right").world["pedestrians"].back()["path"][0][1].get<double>(),
+      6.3);
+  EXPECT_EQ(makeVariant("exp4-static-obstacle").world["obstacles"].size(),
+            makeVariant("exp3-8").world["obstacles"].size() + 1);
+  EXPECT_NE(makeVariant("exp2-redrawn-c").drawn_path.size(),
+            makeVariant("exp3-8").drawn_path.size());
+}
+
+TEST(ExperimentVariants, SketchNoiseIsSeeded) {
+  const Variant v = makeVariant("exp3-8");
+  EXPECT_EQ(makeSketch(v, SketchNoise{}, 5), makeSketch(v, SketchNoise{}, 5));
+  EXPECT_NE(makeSketch(v, SketchNoise{}, 5), makeSketch(v, SketchNoise{}, 6));
+  SketchNoise none;
+  none.landmark_sigma_m = none.distance_sigma = none.distance_round_m = 0;
+  none.path_sigma_m = none.jitter_px = 0;
+  // Without noise the distances are the true ones (L1 is 2.8 m from the start).
+  const Json s = makeSketch(v, none, 1);
+  EXPECT_NEAR(s["landmarks"][0]["distance_m"].get<double>(), std::hypot(3.6 - 0.8, 9.6 - 10.1),
+              1e-9);
+  SketchNoise bad;
+  bad.distance_sigma = -1;
+  EXPECT_THROW(makeSketch(v, bad, 1), InputError);
+}
+
+TEST(Plot, DrawsAxesAndSeries) {
+  PlotSpec spec;
+  spec.title = "t";
+  const cv::Mat img = drawLinePlot(spec, {{"a", {0, 1, 2}, {1, 3, 2}, plotColor(0)},
+                                          {"no data", {0, 1, 2}, {NAN, NAN, NAN}, plotColor(1)}});
+  ASSERT_EQ(img.cols, spec.width);
+  ASSERT_EQ(img.rows, spec.height);
+  // Some pixels carry the first series' colour (the line was drawn).
+  int coloured = 0;
+  const cv::Vec3b c(180, 100, 30);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) coloured += img.at<cv::Vec3b>(y, x) == c;
+  EXPECT_GT(coloured, 50);
+}
+
+}  // namespace
+}  // namespace sketchnav::app
