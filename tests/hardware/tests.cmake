@@ -1,0 +1,22 @@
+# Device tests over loopback with real peer processes: Aravis's fake GigE Vision camera
+# (arv-fake-gv-camera-0.8, from aravis-tools) and `sketchnav base-emulator`.
+# The fake GigE camera listens on the fixed GVCP port 3956, so these tests share a lock and
+# never run concurrently with each other.
+find_program(ARV_FAKE_GV_CAMERA arv-fake-gv-camera-0.8)
+if(NOT ARV_FAKE_GV_CAMERA)
+  set(ARV_FAKE_GV_CAMERA arv-fake-gv-camera-0.8)  # the tests fail with a clear message
+endif()
+if(SKETCHNAV_BUILD_TESTS)
+  add_executable(test_hw_loopback
+    ${CMAKE_CURRENT_LIST_DIR}/test_aravis_gv.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_base_emulator.cpp)
+  add_dependencies(test_hw_loopback sketchnav)  # the tests run the command itself
+  target_link_libraries(test_hw_loopback PRIVATE sketchnav::hw opencv_core
+                        sketchnav_test_support GTest::gtest_main)
+  target_include_directories(test_hw_loopback PRIVATE ${CMAKE_CURRENT_LIST_DIR})
+  target_compile_definitions(test_hw_loopback PRIVATE
+    ARV_FAKE_GV_CAMERA="${ARV_FAKE_GV_CAMERA}"
+    SKETCHNAV_EXE="$<TARGET_FILE:sketchnav>")
+  gtest_discover_tests(test_hw_loopback DISCOVERY_TIMEOUT 60
+    PROPERTIES TIMEOUT 120 LABELS hardware RESOURCE_LOCK gvcp_3956)
+endif()
