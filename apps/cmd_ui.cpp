@@ -1,16 +1,276 @@
-// sketchnav ui: the local web UI: sketch editor, live run view and control.
+// sketchnav ui: the local web UI (sketch editor, live run view and control). Binds 127.0.0.1
+// unless told otherwise; see doc/ui.md.
+// Eigen-using headers first: a macro pulled in by httplib.h (server.h) breaks Eigen's headers.
+// clang-format off
+#include "run_harness.h"
+#include "sketchnav/landmarks/objectness.h"
+#include "sketchnav/mapsketch/io.h"
+#include "sketchnav/mapsketch/route.h"
+#include "sketchnav/sim/world.h"
+#include "run_api.h"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <csignal>
+#include <filesystem>
 #include <iostream>
+#include <thread>
 
 #include "cli.h"
+#include "server.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
+#include "sketchnav/core/paths.h"
+#include "sketchnav/hw/registry.h"
+#include "sketchnav/sim/register.h"
+// clang-format on
 
 namespace sketchnav::app {
 namespace {
-int runUi(const std::vector<std::string>& argv, GlobalOptions&) {
+namespace fs = std::filesystem;
+
+ui::Server* g_server = nullptr;
+extern "C" void onSignal(int) {
+  // httplib's stop() only flips a flag and shuts the listening socket: safe enough here.
+  if (g_server) g_server->stop();
+}
+
+bool endsWith(const std::string& s, const std::string& suffix) {
+  return s.size() >= suffix.size() &&
+         s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
+}
+
+// The sketch a run uses when the page names none (as runNavigation picks it).
+std::string sketchFor(const ui::RunRequest& rq) {
+  if (!rq.sketch.empty()) return rq.sketch;
+  const std::string w = rq.hardware() ? "lab" : rq.world;
+  if (w.find('/') != std::string::npos || endsWith(w, ".json")) {
+    if (endsWith(w, ".world.json")) return w.substr(0, w.size() - 11) + ".sketch.json";
+    return "";
+  }
+  return resourcePath("sketches/" + w + ".sketch.json");
+}
+
+// What the page's map shows, in the odometry frame (origin at the start, x along the
+// robot's initial heading) where the executive's pose estimate lives: the sketch as the
+// executive aligns it (start on the robot, first section along its heading) and, in
+// simulation, the world seen from the robot's start pose.
+Json mapGeometry(const ui::RunRequest& rq) {
+  Json g = {{"frame", "odometry"}};
+  using V = Eigen::Vector2d;
+  auto pt = [](const V& p) { return Json::array({p.x(), p.y()}); };
+  const std::string sketch_path = sketchFor(rq);
+  if (!sketch_path.empty() && fs::exists(sketch_path)) {
+    const mapsketch::Sketch sk = mapsketch::loadSketch(sketch_path);
+    const mapsketch::Route route = mapsketch::toRoute(sk);
+    const double c = std::cos(-route.start_heading_rad), s = std::sin(-route.start_heading_rad);
+    auto toOdom = [&](const V& p) {
+      const V d = p - route.start_m;
+      return V(c * d.x() - s * d.y(), s * d.x() + c * d.y());
+    };
+    Json path = Json::array();
+    for (const auto& p : sk.path) {
+      const V rp((p.x() - sk.start.x()) * route.scale_m_per_px,
+                 -(p.y() - sk.start.y()) * route.scale_m_per_px);
+      path.push_back(pt(toOdom(rp + route.start_m)));
+    }
+    Json guides = Json::array(), lms = Json::array();
+    for (const auto& p : route.guide_points_m) guides.push_back(pt(toOdom(p)));
+    for (const auto& sec : route.sections)
+      for (const auto& l : sec.landmarks) {
+        const V p = toOdom(l.position_m);
+        lms.push_back({{"id", l.id}, {"class", l.class_name}, {"x", p.x()}, {"y", p.y()}});
+      }
+    g["sketch"] = sketch_path;
+    g["sketch_path"] = path;
+    g["guide_points"] = guides;
+    g["sketch_landmarks"] = lms;
+  }
+  if (!rq.hardware()) {
+    const sim::World w = sim::loadWorldByName(rq.world);
+    const double c = std::cos(-w.start.theta), s = std::sin(-w.start.theta);
+    auto toOdom = [&](const V& p) {
+      const V d = p - V(w.start.x, w.start.y);
+      return V(c * d.x() - s * d.y(), s * d.x() + c * d.y());
+    };
+    Json floor = Json::array(), walls = Json::array(), obst = Json::array(), lms = Json::array();
+    for (const auto& p : w.floor) floor.push_back(pt(toOdom(p)));
+    for (const auto& wl : w.walls) {
+      const V a = toOdom(wl.a), b = toOdom(wl.b);
+      walls.push_back({a.x(), a.y(), b.x(), b.y(), wl.thickness});
+    }
+    for (const auto& d : w.doors)
+      if (!d.open) {
+        const V a = toOdom(d.a), b = toOdom(d.b);
+        walls.push_back({a.x(), a.y(), b.x(), b.y(), 0.05});
+      }
+    for (const auto& o : w.obstacles) {
+      if (o.shape == sim::Obstacle::Shape::Cylinder) {
+        const V p = toOdom(o.centre);
+        obst.push_back({{"x", p.x()}, {"y", p.y()}, {"r", o.radius}});
+      } else {
+        Json poly = Json::array();
+        const double cy = std::cos(o.yaw), sy = std::sin(o.yaw);
+        for (const auto& [u, v] : {std::pair{1, 1}, {-1, 1}, {-1, -1}, {1, -1}}) {
+          const double dx = u * o.size_x / 2, dy = v * o.size_y / 2;
+          poly.push_back(pt(toOdom(o.centre + V(cy * dx - sy * dy, sy * dx + cy * dy))));
+        }
+        obst.push_back({{"polygon", poly}});
+      }
+    }
+    for (const auto& l : w.landmarks) {
+      const V p = toOdom(l.position);
+      lms.push_back({{"id", l.id}, {"class", l.class_name}, {"x", p.x()}, {"y", p.y()}});
+    }
+    const V goal = toOdom(w.goal.centre);
+    g["world"] = rq.world;
+    g["floor"] = floor;
+    g["walls"] = walls;
+    g["obstacles"] = obst;
+    g["world_landmarks"] = lms;
+    g["goal"] = {{"x", goal.x()}, {"y", goal.y()}, {"r", w.goal.radius}};
+  }
+  return g;
+}
+
+// "Camera only": frames for the live view and captures (e.g. building a landmark set with the
+// robot's camera, or a webcam: video://0), nothing else opened, nothing driven.
+Json cameraOnly(const ui::RunRequest& rq, const ui::RunHooks& h) {
+  hw::registerBuiltinDrivers();
+  sim::registerDrivers();
+  hw::DeviceContext ctx;
+  ctx.clock = std::make_shared<hw::SteadyClock>();
+  auto camera = h.wrap_camera(hw::Registry::instance().createCamera(rq.camera, ctx));
+  h.on_event({{"type", "start"}, {"t", 0.0}, {"sections", 0}, {"camera_only", true}});
+  int errors = 0;
+  auto next = std::chrono::steady_clock::now();
+  while (!h.stop_requested()) {
+    hw::Frame f;
+    const hw::GrabStatus st = camera->grab(f, 0.5);
+    if (st == hw::GrabStatus::EndOfStream)
+      return {{"success", true}, {"reason", "end of the images"}};
+    if (st == hw::GrabStatus::Error && ++errors > 20)
+      throw RuntimeError("camera " + rq.camera + ": " + camera->stats().last_error);
+    if (st == hw::GrabStatus::Ok) errors = 0;
+    // Recorded sources (folder://, video files) deliver at once: show them at ~10 Hz.
+    std::this_thread::sleep_until(next);
+    next = std::chrono::steady_clock::now() + std::chrono::milliseconds(100);
+  }
+  return {{"success", true}, {"reason", "camera closed"}};
+}
+
+// The run page's runner: `sketchnav run` (runNavigation) in real time, reporting to the page.
+Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::string& landmarks,
+                 const std::string& model_cache) {
+  RunOptions o;
+  o.world = rq.world;
+  o.sketch = rq.sketch;
+  o.robot = rq.robot;
+  o.camera = rq.camera;
+  o.laser = rq.laser;
+  o.sonar = rq.sonar;
+  o.seed = rq.seed;
+  o.max_time_s = rq.max_time_s;
+  o.realtime = true;  // a person is watching: the simulator at the robot's pace
+  o.landmark_dir = landmarks;
+  o.cache_dir = model_cache;
+  o.progress = true;
+  o.wrap_camera = h.wrap_camera;
+  o.wrap_base = h.wrap_base;
+  o.on_event = h.on_event;
+  o.on_tick = h.on_tick;
+  o.on_observation = h.on_observation;
+  o.stop_requested = h.stop_requested;
+  try {
+    h.on_map(mapGeometry(rq));
+  } catch (const std::exception& e) {
+    // The run reports a bad world or sketch itself, with the same message.
+    log::warn("ui", "no map for the run page", {{"error", e.what()}});
+    h.on_map(Json::object());
+  }
+  return runNavigation(o);
+}
+
+std::vector<std::string> filesEndingIn(const std::string& dir, const std::string& suffix) {
+  std::vector<std::string> out;
+  std::error_code ec;
+  if (dir.empty() || !fs::is_directory(dir, ec)) return out;
+  for (const auto& e : fs::directory_iterator(dir, ec))
+    if (e.is_regular_file() && endsWith(e.path().filename().string(), suffix))
+      out.push_back(e.path().string());
+  std::sort(out.begin(), out.end());
+  return out;
+}
+
+int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("ui", "the local web UI: sketch editor, live run view and control", "[options]");
-  // Only --help is answered until the capability lands; everything else says so.
-  for (const auto& a : argv)
-    if (a == "--help" || a == "-h") return (std::cout << args.helpText(), 0);
-  return notAvailable("ui", "the web UI", 4);
+  args.option("landmarks", "landmark set: one folder per class (default: the demo set)")
+      .option("sketch-dir", "directory sketches are opened from and saved to", ".")
+      .option("capture-dir", "where the run page saves captured photos (default: --landmarks)")
+      .option("model-cache", "landmark model cache directory (default: ~/.cache/sketchnav)")
+      .option("host", "address to bind (only loopback is safe)", "127.0.0.1")
+      .option("port", "TCP port (0 = any free port)", "8080")
+      .option("allow-host", "extra Host name to accept, e.g. robot.local (with --host 0.0.0.0)");
+  if (!args.parse(argv)) return 0;
+  const int port = args.getInt("port");
+  if (port < 0 || port > 65535) throw InputError("sketchnav ui: --port must be in 0..65535");
+
+  ui::ServerOptions so;
+  so.host = args.get("host");
+  so.port = port;
+  so.web_root = resourcePath("web");
+  if (args.has("allow-host")) so.extra_hosts.push_back(args.get("allow-host"));
+  ui::EditorOptions eo;
+  eo.landmarks_dir = args.has("landmarks") ? args.get("landmarks") : resourcePath("landmarks");
+  eo.sketch_dir = args.get("sketch-dir");
+  eo.examples_dir = resourcePath("sketches");
+
+  ui::RunApiOptions ro;
+  const std::string landmarks = eo.landmarks_dir;
+  const std::string cache = args.has("model-cache") ? args.get("model-cache") : "";
+  ro.runner = [landmarks, cache](const ui::RunRequest& rq, const ui::RunHooks& h) {
+    return rq.camera_only ? cameraOnly(rq, h) : runFromPage(rq, h, landmarks, cache);
+  };
+  // The live view draws the windows perception examined: the same proposer, same settings.
+  auto objectness = std::make_shared<landmarks::Objectness>(landmarks::ObjectnessParams{});
+  ro.propose_windows = [objectness](const cv::Mat& img) {
+    std::vector<cv::Rect> boxes;
+    for (const auto& w : objectness->propose(img, nav::PerceptionParams{}.max_windows))
+      boxes.push_back(w.box);
+    return boxes;
+  };
+  ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : eo.landmarks_dir;
+  ro.worlds = {"lab"};
+  for (const auto& f : filesEndingIn(resourcePath("worlds"), ".world.json")) {
+    const std::string n = fs::path(f).filename().string();
+    const std::string name = n.substr(0, n.size() - 11);
+    if (std::find(ro.worlds.begin(), ro.worlds.end(), name) == ro.worlds.end())
+      ro.worlds.push_back(name);
+  }
+  ro.sketches = filesEndingIn(eo.examples_dir, ".sketch.json");
+  for (const auto& f : filesEndingIn(eo.sketch_dir, ".sketch.json")) ro.sketches.push_back(f);
+
+  // Declared before the server so the server (whose routes use it) goes first.
+  ui::RunController runs(ro);
+  ui::Server server(so);
+  ui::addEditorRoutes(server, eo);
+  ui::addRunRoutes(server, runs);
+  server.bind();
+  if (so.host != "127.0.0.1" && so.host != "localhost" && so.host != "::1")
+    log::warn("ui", "listening beyond this machine: anyone who can reach it can drive the robot",
+              {{"host", so.host}});
+  if (g.json)
+    printJson({{"url", server.url()}, {"port", server.port()}});
+  else
+    std::cout << "sketchnav ui: editor at " << server.url() << ", live run at " << server.url()
+              << "run.html (Ctrl+C to stop)" << std::endl;
+  g_server = &server;
+  std::signal(SIGINT, onSignal);
+  std::signal(SIGTERM, onSignal);
+  server.serve();
+  g_server = nullptr;
+  return 0;  // ~RunController stops a run still going (the base first) and waits for it
 }
 const CommandRegistration reg("ui", "the local web UI: sketch editor, live run view and control",
                               runUi);

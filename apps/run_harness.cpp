@@ -95,7 +95,11 @@ class RunObserver final : public nav::ExecutiveObserver {
   }
   std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
 
+  std::function<void(const Json&)> on_event;  // RunOptions hooks
+  std::function<void(const nav::TelemetryRow&)> on_tick;
+
   void onEvent(const nlohmann::json& e) override {
+    if (on_event) on_event(e);
     if (events_.is_open()) events_ << e.dump() << std::endl;  // flushed per line
     if (!progress_) return;
     const std::string type = e.value("type", "");
@@ -134,6 +138,7 @@ class RunObserver final : public nav::ExecutiveObserver {
   }
 
   void onTick(const nav::TelemetryRow& r) override {
+    if (on_tick) on_tick(r);
     hw::Pose2D truth;
     if (sim_) truth = sim_->truePose();
     odom.push_back(r.odom);
@@ -170,6 +175,24 @@ class RunObserver final : public nav::ExecutiveObserver {
   int sections_;
   std::ofstream events_, tele_;
   double next_progress_ = 0;
+};
+
+// Hands every frame perception examined, and its result, to RunOptions::on_observation.
+class TappedPerception final : public nav::Perception {
+ public:
+  TappedPerception(nav::Perception& inner,
+                   std::function<void(const hw::Frame&, const nav::Observation&)> tap)
+      : inner_(inner), tap_(std::move(tap)) {}
+  nav::Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                           const std::vector<std::string>& classes) override {
+    nav::Observation obs = inner_.observe(frame, k, classes);
+    if (tap_) tap_(frame, obs);
+    return obs;
+  }
+
+ private:
+  nav::Perception& inner_;
+  std::function<void(const hw::Frame&, const nav::Observation&)> tap_;
 };
 
 void drawTrajectory(const std::string& path, const sim::World& world,
@@ -244,6 +267,7 @@ Json runNavigation(const RunOptions& o) {
     if (!o.sonar.empty()) sonar = hw::Registry::instance().createRange(o.sonar, ctx);
   }
   if (o.wrap_camera && camera) camera = o.wrap_camera(std::move(camera));
+  if (o.wrap_base && base) base = o.wrap_base(std::move(base));
   if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
 
   // --- sketch -> route ----------------------------------------------------------------------
@@ -312,6 +336,9 @@ Json runNavigation(const RunOptions& o) {
   if (!o.out_dir.empty()) fs::create_directories(o.out_dir);
   RunObserver observer(o.out_dir, o.progress, simr.get(), static_cast<int>(route.sections.size()));
   nav::LandmarkPerception perception(model, pp);
+  observer.on_event = o.on_event;
+  observer.on_tick = o.on_tick;
+  TappedPerception tapped(perception, o.on_observation);
   nav::Devices dev;
   dev.camera = camera.get();
   dev.base = base.get();
@@ -322,8 +349,24 @@ Json runNavigation(const RunOptions& o) {
   const auto w0 = wall::now();
   nav::ExecutiveSummary es;
   {
-    nav::Executive ex(route, dev, perception, settings, &observer);
-    es = ex.run();
+    nav::Perception& used = o.on_observation ? static_cast<nav::Perception&>(tapped) : perception;
+    nav::Executive ex(route, dev, used, settings, &observer);
+    if (o.stop_requested) {
+      // Executive::run()'s loop, asking before every tick whether the user pressed Stop.
+      ex.start();
+      double next = dev.clock->now();
+      while (!ex.done()) {
+        next += settings.exec.tick_s;
+        dev.clock->sleepUntil(next);
+        if (o.stop_requested())
+          ex.stop("stopped by user");
+        else
+          ex.step();
+      }
+      es = ex.summary();
+    } else {
+      es = ex.run();
+    }
   }
   const double wall_s = std::chrono::duration<double>(wall::now() - w0).count();
 

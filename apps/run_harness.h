@@ -9,6 +9,8 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
+#include "sketchnav/nav/executive.h"
+#include "sketchnav/nav/perception.h"
 
 namespace sketchnav::app {
 
@@ -26,8 +28,18 @@ struct RunOptions {
   std::string robot, camera, laser, sonar;
   Config config;         // --config / --set (nav.*, servo.*, sim.*, ...)
   bool progress = true;  // progress lines on stderr
-  /// Test hook: wraps the camera (e.g. to drop it mid-run). Never used by the command.
+  /// Wraps the camera (tests: drop it mid-run; `sketchnav ui`: show and capture its frames).
   std::function<std::unique_ptr<hw::Camera>(std::unique_ptr<hw::Camera>)> wrap_camera;
+  // Hooks of the live run page (`sketchnav ui`); all called on the run's thread. Unset = none.
+  /// Wraps the base (the page's Stop goes through the wrapper).
+  std::function<std::unique_ptr<hw::Base>(std::unique_ptr<hw::Base>)> wrap_base;
+  std::function<void(const Json&)> on_event;              // every executive event
+  std::function<void(const nav::TelemetryRow&)> on_tick;  // every control tick
+  /// Every frame perception examined, with what it found.
+  std::function<void(const hw::Frame&, const nav::Observation&)> on_observation;
+  /// Polled before every control tick: true -> the executive stops the base and the run ends
+  /// (failed, reason "stopped by user").
+  std::function<bool()> stop_requested;
 };
 
 /// Runs one navigation. Returns the summary object (what summary.json holds). Throws

@@ -1,0 +1,682 @@
+// The live run page's state and API (run_api.h). One Live record is shared by the HTTP
+// threads (reading) and the run thread (the hooks, writing), behind one mutex; frames are
+// cloned in, so nothing the run thread reuses is ever read by a request.
+// Eigen-using headers (through nav) come in via run_api.h before httplib's macros matter.
+#include "run_api.h"
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <filesystem>
+#include <map>
+#include <regex>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
+
+namespace fs = std::filesystem;
+
+namespace sketchnav::ui {
+
+namespace {
+double wallNow() {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now().time_since_epoch()).count();
+}
+Json statsJson(const hw::DeviceStats& s) {
+  return {{"received", s.received},
+          {"dropped", s.dropped},
+          {"incomplete", s.incomplete},
+          {"last_error", s.last_error}};
+}
+}  // namespace
+
+// ---- request -------------------------------------------------------------------------------
+
+RunRequest RunRequest::fromJson(const Json& j) {
+  if (!j.is_object()) throw InputError("run request: expected a JSON object");
+  RunRequest r;
+  auto str = [&](const char* key, std::string& out) {
+    if (!j.contains(key) || j[key].is_null()) return;
+    if (!j[key].is_string())
+      throw InputError(std::string("run request: '") + key + "' must be a string");
+    out = j[key].get<std::string>();
+    if (out.size() > 500) throw InputError(std::string("run request: '") + key + "' is too long");
+  };
+  str("world", r.world);
+  str("sketch", r.sketch);
+  str("robot", r.robot);
+  str("camera", r.camera);
+  str("laser", r.laser);
+  str("sonar", r.sonar);
+  if (j.contains("seed")) {
+    if (!j["seed"].is_number_integer() || j["seed"].get<int>() < 0)
+      throw InputError("run request: 'seed' must be an integer >= 0");
+    r.seed = j["seed"].get<int>();
+  }
+  if (j.contains("max_time_s")) {
+    if (!j["max_time_s"].is_number() || !(j["max_time_s"].get<double>() >= 0))
+      throw InputError("run request: 'max_time_s' must be a number >= 0");
+    r.max_time_s = j["max_time_s"].get<double>();
+  }
+  if (j.contains("camera_only")) {
+    if (!j["camera_only"].is_boolean())
+      throw InputError("run request: 'camera_only' must be true or false");
+    r.camera_only = j["camera_only"].get<bool>();
+  }
+  if (r.camera_only) {
+    if (r.camera.empty()) throw InputError("run request: 'camera' URI is required for camera only");
+    return r;
+  }
+  if (!r.hardware() && r.world.empty())
+    throw InputError("run request: 'world' is required for a simulated run");
+  if (r.hardware() && r.robot.empty())
+    throw InputError("run request: 'robot' URI is required with hardware devices");
+  return r;
+}
+
+Json RunRequest::toJson() const {
+  Json j = {{"seed", seed}, {"max_time_s", max_time_s}};
+  if (camera_only) {
+    j["mode"] = "camera";
+    j["camera"] = camera;
+  } else if (hardware()) {
+    j["mode"] = "hardware";
+    j["robot"] = robot;
+    j["camera"] = camera;
+    j["laser"] = laser;
+    j["sonar"] = sonar;
+  } else {
+    j["mode"] = "sim";
+    j["world"] = world;
+  }
+  j["sketch"] = sketch;
+  return j;
+}
+
+std::string safeClassName(const std::string& name) {
+  static const std::regex ok(R"([A-Za-z0-9_][A-Za-z0-9_. -]{0,79})");
+  if (!std::regex_match(name, ok) || name.find("..") != std::string::npos || name.back() == ' ' ||
+      name.back() == '.')
+    throw InputError("capture: class name '" + name.substr(0, 100) +
+                     "' is not allowed (letters, digits, '_', '-', '.', spaces; at most 80)");
+  return name;
+}
+
+// ---- live state ----------------------------------------------------------------------------
+
+struct RunController::Live {
+  mutable std::mutex m;
+  // run
+  std::string status = "idle";  // idle starting running stopping stopped succeeded failed error
+  std::string reason;
+  Json request;
+  Json summary;
+  bool hardware = false;
+  double started_wall = 0;
+  std::atomic<bool> stop_requested{false};
+  // executive
+  bool has_tick = false;
+  nav::TelemetryRow tick;
+  int sections = 0;
+  double route_length_m = 0;
+  std::deque<Json> events;
+  std::map<std::string, Json> landmarks;  // id -> {id, class, section, state, ...}
+  std::vector<std::pair<double, double>> trajectory;
+  Json map_geometry;
+  // camera
+  cv::Mat frame;
+  std::uint64_t frame_seq = 0;
+  double frame_wall = 0;
+  std::uint64_t frames = 0;
+  hw::DeviceStats camera_stats;
+  bool camera_open = false;
+  std::vector<nav::Detection> detections;
+  std::uint64_t detections_seq = 0;
+  cv::Mat obs_frame;  // the frame perception examined last
+  std::vector<cv::Rect> windows_boxes;
+  std::uint64_t windows_seq = 0;  // obs frame the boxes belong to (0 = none)
+  int windows = 0;
+  double perception_ms = 0;
+  // base
+  class StoppableBase* base = nullptr;
+  bool base_open = false, base_ok = false;
+  hw::DeviceStats base_stats;
+  double v_sent = 0, w_sent = 0;
+  int base_stops = 0;
+  std::uint64_t base_seq = 0;      // StoppableBase call number of v_sent / w_sent / base_last
+  std::string base_last = "none";  // none | command | stop
+
+  void reset() {
+    status = "starting";
+    reason.clear();
+    summary = nullptr;
+    stop_requested = false;
+    has_tick = false;
+    tick = {};
+    sections = 0;
+    route_length_m = 0;
+    events.clear();
+    landmarks.clear();
+    trajectory.clear();
+    map_geometry = nullptr;
+    frame.release();
+    frame_seq = frames = 0;
+    frame_wall = 0;
+    camera_stats = {};
+    camera_open = false;
+    detections.clear();
+    detections_seq = 0;
+    obs_frame.release();
+    windows_boxes.clear();
+    windows_seq = 0;
+    windows = 0;
+    perception_ms = 0;
+    base_open = base_ok = false;
+    base_stats = {};
+    v_sent = w_sent = 0;
+    base_stops = 0;
+    base_seq = 0;
+    base_last = "none";
+  }
+};
+
+// A Base that the page can stop from its own thread. Every call to the real base is
+// serialised by one mutex; once halted, each command becomes stop(). A real robot is
+// stopped at once from the request's thread (its drivers take stop() from any thread, like
+// GatedBase's camera callback); the simulator is stepped by the run thread only, so there the
+// halt takes effect at the next control tick (50 ms of simulated time).
+class StoppableBase final : public hw::Base {
+ public:
+  StoppableBase(std::unique_ptr<hw::Base> inner, std::shared_ptr<RunController::Live> live)
+      : inner_(std::move(inner)), live_(std::move(live)) {
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->base = this;
+    live_->base_open = true;
+    live_->base_ok = inner_->ok();
+  }
+  ~StoppableBase() override {
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->base = nullptr;
+  }
+  void command(double v, double w) override {
+    bool halted;
+    std::uint64_t seq;
+    {
+      std::lock_guard<std::mutex> l(m_);
+      halted = halted_;
+      if (halted)
+        inner_->stop();
+      else
+        inner_->command(v, w);
+      seq = ++calls_;
+    }
+    // live_->m is taken after m_ is released (halt() takes them the other way round); `seq`
+    // keeps the record in the order the base got the calls.
+    if (halted)
+      record(0, 0, "stop", seq);
+    else
+      record(v, w, "command", seq);
+  }
+  void stop() noexcept override {
+    try {
+      std::uint64_t seq;
+      {
+        std::lock_guard<std::mutex> l(m_);
+        inner_->stop();
+        seq = ++calls_;
+      }
+      record(0, 0, "stop", seq);
+    } catch (...) {
+    }
+  }
+  bool odometry(hw::Odometry& out) override {
+    std::lock_guard<std::mutex> l(m_);
+    return inner_->odometry(out);
+  }
+  bool ok() const override {
+    std::lock_guard<std::mutex> l(m_);
+    return inner_->ok();
+  }
+  hw::DeviceStats stats() const override {
+    std::lock_guard<std::mutex> l(m_);
+    return inner_->stats();
+  }
+  std::string uri() const override { return inner_->uri(); }
+
+  /// Called with live_->m held (from RunController::stop()).
+  void halt(bool from_this_thread) {
+    halted_ = true;
+    if (!from_this_thread) return;
+    std::lock_guard<std::mutex> l(m_);
+    inner_->stop();
+    live_->base_seq = ++calls_;
+    live_->v_sent = live_->w_sent = 0;
+    live_->base_stops++;
+    live_->base_last = "stop";
+  }
+
+ private:
+  void record(double v, double w, const char* what, std::uint64_t seq) {
+    bool ok;
+    hw::DeviceStats st;
+    {
+      std::lock_guard<std::mutex> l(m_);
+      ok = inner_->ok();
+      st = inner_->stats();
+    }
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->base_ok = ok;
+    live_->base_stats = st;
+    if (std::string(what) == "stop") live_->base_stops++;
+    if (seq < live_->base_seq) return;  // a later call (halt) is already recorded
+    live_->base_seq = seq;
+    live_->v_sent = v;
+    live_->w_sent = w;
+    live_->base_last = what;
+  }
+  std::unique_ptr<hw::Base> inner_;
+  std::shared_ptr<RunController::Live> live_;
+  mutable std::mutex m_;
+  std::uint64_t calls_ = 0;  // calls made to inner_ (guarded by m_)
+  std::atomic<bool> halted_{false};
+};
+
+// A Camera that keeps a copy of each frame for the page (live view and capture).
+class TapCamera final : public hw::Camera {
+ public:
+  TapCamera(std::unique_ptr<hw::Camera> inner, std::shared_ptr<RunController::Live> live)
+      : inner_(std::move(inner)), live_(std::move(live)) {
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->camera_open = true;
+  }
+  ~TapCamera() override {
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->camera_open = false;
+  }
+  hw::GrabStatus grab(hw::Frame& frame, double timeout_s) override {
+    const hw::GrabStatus st = inner_->grab(frame, timeout_s);
+    const hw::DeviceStats stats = inner_->stats();
+    cv::Mat copy;
+    if (st == hw::GrabStatus::Ok && !frame.image.empty()) copy = frame.image.clone();
+    std::lock_guard<std::mutex> l(live_->m);
+    live_->camera_stats = stats;
+    if (!copy.empty()) {
+      live_->frame = copy;
+      live_->frame_seq = frame.seq;
+      live_->frame_wall = wallNow();
+      live_->frames++;
+    }
+    return st;
+  }
+  hw::Intrinsics intrinsics() const override { return inner_->intrinsics(); }
+  hw::DeviceStats stats() const override { return inner_->stats(); }
+  std::string uri() const override { return inner_->uri(); }
+
+ private:
+  std::unique_ptr<hw::Camera> inner_;
+  std::shared_ptr<RunController::Live> live_;
+};
+
+// The frame the page shows: the one perception examined last while it is recent (so the
+// windows and detections drawn on it are exactly where perception found them), else the
+// latest one (perception idle: no landmark expected nearby). Caller holds L.m.
+static bool showObserved(const RunController::Live& L) {
+  return !L.obs_frame.empty() && L.frame_seq >= L.detections_seq &&
+         L.frame_seq - L.detections_seq <= 10;
+}
+
+// ---- controller ----------------------------------------------------------------------------
+
+RunController::RunController(RunApiOptions options)
+    : opt_(std::move(options)), live_(std::make_shared<Live>()) {
+  if (!opt_.runner) throw InputError("ui: no runner given to the run page");
+}
+
+RunController::~RunController() {
+  stop();
+  join();
+}
+
+void RunController::join() {
+  std::lock_guard<std::mutex> l(start_mutex_);
+  if (thread_.joinable()) thread_.join();
+}
+
+void RunController::start(const RunRequest& request) {
+  std::lock_guard<std::mutex> l(start_mutex_);
+  {
+    std::lock_guard<std::mutex> ll(live_->m);
+    const std::string& s = live_->status;
+    if (s == "starting" || s == "running" || s == "stopping")
+      throw InputError("a run is already going: stop it first");
+  }
+  if (thread_.joinable()) thread_.join();  // the previous run has finished
+  {
+    std::lock_guard<std::mutex> ll(live_->m);
+    live_->reset();
+    live_->request = request.toJson();
+    live_->hardware = request.hardware();
+    live_->started_wall = wallNow();
+  }
+  log::info("ui", "run started from the page", {{"request", request.toJson().dump()}});
+  thread_ = std::thread([this, request] { runThread(request); });
+}
+
+bool RunController::stop() {
+  std::lock_guard<std::mutex> l(live_->m);
+  const std::string s = live_->status;
+  if (s != "starting" && s != "running" && s != "stopping") return false;
+  live_->stop_requested = true;
+  if (live_->base) live_->base->halt(live_->hardware);
+  live_->status = "stopping";
+  Json e = {{"type", "stop_requested"}, {"t", live_->has_tick ? live_->tick.t : 0.0}};
+  live_->events.push_back(e);
+  log::warn("ui", "stop pressed on the run page", {});
+  return true;
+}
+
+void RunController::runThread(RunRequest request) {
+  auto live = live_;
+  RunHooks h;
+  h.on_event = [live](const Json& e) {
+    std::lock_guard<std::mutex> l(live->m);
+    live->events.push_back(e);
+    while (live->events.size() > 40) live->events.pop_front();
+    const std::string type = e.value("type", "");
+    if (type == "start") {
+      live->sections = e.value("sections", 0);
+      live->route_length_m = e.value("route_length_m", 0.0);
+      if (live->status == "starting") live->status = "running";
+    }
+    if (e.contains("id") && e["id"].is_string() && type.rfind("landmark_", 0) == 0) {
+      Json& lm = live->landmarks[e["id"].get<std::string>()];
+      lm["id"] = e["id"];
+      if (e.contains("class")) lm["class"] = e["class"];
+      if (e.contains("section")) lm["section"] = e["section"];
+      lm["state"] = type.substr(9);  // seen passed missed lost
+      if (e.contains("inliers")) lm["inliers"] = e["inliers"];
+    }
+  };
+  h.on_tick = [live](const nav::TelemetryRow& r) {
+    std::lock_guard<std::mutex> l(live->m);
+    live->tick = r;
+    live->has_tick = true;
+    if (live->status == "starting") live->status = "running";
+    const auto& tr = live->trajectory;
+    if (tr.empty() || std::hypot(tr.back().first - r.odom.x, tr.back().second - r.odom.y) > 0.05)
+      live->trajectory.emplace_back(r.odom.x, r.odom.y);
+  };
+  h.on_observation = [live](const hw::Frame& f, const nav::Observation& o) {
+    cv::Mat copy = f.image.clone();
+    std::lock_guard<std::mutex> l(live->m);
+    live->obs_frame = copy;
+    live->detections = o.detections;
+    live->detections_seq = f.seq;
+    live->windows = o.timing.windows;
+    live->perception_ms = o.timing.total_ms;
+  };
+  h.wrap_camera = [live](std::unique_ptr<hw::Camera> c) -> std::unique_ptr<hw::Camera> {
+    return std::make_unique<TapCamera>(std::move(c), live);
+  };
+  h.wrap_base = [live](std::unique_ptr<hw::Base> b) -> std::unique_ptr<hw::Base> {
+    auto sb = std::make_unique<StoppableBase>(std::move(b), live);
+    // Stop pressed while the devices were opening: the base never moves.
+    if (live->stop_requested) sb->stop();
+    return sb;
+  };
+  h.stop_requested = [live] { return live->stop_requested.load(); };
+  h.on_map = [live](const Json& m) {
+    std::lock_guard<std::mutex> l(live->m);
+    live->map_geometry = m;
+  };
+
+  Json summary;
+  std::string status, reason;
+  try {
+    summary = opt_.runner(request, h);
+    const bool ok = summary.value("success", false);
+    reason = summary.value("reason", "");
+    status = live->stop_requested ? "stopped" : ok ? "succeeded" : "failed";
+  } catch (const std::exception& e) {
+    status = "error";
+    reason = e.what();
+    log::error("ui", "run failed", {{"error", reason}});
+  }
+  std::lock_guard<std::mutex> l(live->m);
+  live->summary = summary;
+  live->status = status;
+  live->reason = reason;
+  live->base_open = false;
+  // The executive's last tick was before it stopped the base: show the robot at rest.
+  live->tick.v_cmd = live->tick.w_cmd = 0;
+  live->tick.mode = status;
+  live->tick.turn = "";
+}
+
+Json RunController::state() const {
+  const Live& L = *live_;
+  std::lock_guard<std::mutex> l(L.m);
+  Json s;
+  s["status"] = L.status;
+  s["reason"] = L.reason;
+  s["request"] = L.request;
+  s["active"] = L.status == "starting" || L.status == "running" || L.status == "stopping";
+  s["sections"] = L.sections;
+  s["route_length_m"] = L.route_length_m;
+  if (L.has_tick) {
+    const auto& r = L.tick;
+    s["t"] = r.t;
+    s["section"] = std::min(r.section + 1, std::max(L.sections, 1));  // 1-based k of n
+    s["mode"] = r.mode;
+    s["turn"] = r.turn;
+    s["v"] = r.v_cmd;
+    s["w"] = r.w_cmd;
+    s["servo_error"] = std::isfinite(r.servo_error) ? Json(r.servo_error) : Json(nullptr);
+    s["pose"] = {{"x", r.odom.x}, {"y", r.odom.y}, {"theta", r.odom.theta}};
+    s["landmark"] = r.landmark;
+    s["front_free_m"] = r.front_free_m;
+  } else {
+    s["t"] = 0;
+    s["section"] = 0;
+    s["mode"] = "";
+    s["turn"] = "";
+    s["v"] = 0;
+    s["w"] = 0;
+    s["pose"] = nullptr;
+    s["landmark"] = "";
+  }
+  // What actually reached the base: after Stop this is 0 even while the executive winds down.
+  s["base"] = {{"v", L.v_sent},
+               {"w", L.w_sent},
+               {"last", L.base_last},
+               {"stops", L.base_stops},
+               {"open", L.base_open}};
+  Json lms = Json::array();
+  for (const auto& [id, lm] : L.landmarks) lms.push_back(lm);
+  s["landmarks"] = lms;
+  const double now = wallNow();
+  const double age = L.frame_wall > 0 ? now - L.frame_wall : -1;
+  const bool active = s["active"].get<bool>();
+  Json cam = statsJson(L.camera_stats);
+  cam["open"] = L.camera_open;
+  cam["frames"] = L.frames;
+  cam["seq"] = L.frame_seq;
+  cam["age_s"] = age;
+  cam["ok"] = L.camera_open && age >= 0 && age < 2.0 && L.camera_stats.last_error.empty();
+  Json base = statsJson(L.base_stats);
+  base["open"] = L.base_open;
+  base["ok"] = L.base_open && L.base_ok;
+  Json range = {{"front_free_m", L.has_tick ? Json(L.tick.front_free_m) : Json(nullptr)}};
+  s["health"] = {{"camera", cam}, {"base", base}, {"range", range}, {"active", active}};
+  s["perception"] = {{"windows", L.windows},
+                     {"detections", L.detections.size()},
+                     {"ms", L.perception_ms},
+                     {"frame_seq", L.detections_seq}};
+  s["frame_seq"] = L.frame_seq;
+  s["shown_seq"] = showObserved(L) ? L.detections_seq : L.frame_seq;
+  s["events"] = Json(std::vector<Json>(L.events.begin(), L.events.end()));
+  s["last_event"] = L.events.empty() ? Json(nullptr) : L.events.back();
+  s["summary"] = L.summary;
+  s["elapsed_s"] = L.started_wall > 0 ? now - L.started_wall : 0.0;
+  return s;
+}
+
+Json RunController::map() const {
+  const Live& L = *live_;
+  std::lock_guard<std::mutex> l(L.m);
+  Json tr = Json::array();
+  for (const auto& [x, y] : L.trajectory) tr.push_back({x, y});
+  Json m = {{"geometry", L.map_geometry}, {"trajectory", tr}};
+  m["pose"] = L.has_tick
+                  ? Json{{"x", L.tick.odom.x}, {"y", L.tick.odom.y}, {"theta", L.tick.odom.theta}}
+                  : Json(nullptr);
+  return m;
+}
+
+std::vector<unsigned char> RunController::frameJpeg() const {
+  Live& L = *live_;
+  cv::Mat img;
+  std::vector<nav::Detection> dets;
+  std::vector<cv::Rect> windows;
+  bool observed = false, need_windows = false;
+  std::uint64_t seq = 0;
+  {
+    std::lock_guard<std::mutex> l(L.m);
+    if (L.frame.empty()) return {};
+    observed = showObserved(L);
+    img = (observed ? L.obs_frame : L.frame).clone();
+    if (observed) {
+      dets = L.detections;
+      seq = L.detections_seq;
+      need_windows = opt_.propose_windows && L.windows_seq != seq;
+      windows = L.windows_boxes;
+    }
+  }
+  if (need_windows) {
+    // Computed here, outside the lock and off the run thread, once per examined frame.
+    try {
+      windows = opt_.propose_windows(img);
+    } catch (const std::exception& e) {
+      windows.clear();
+      log::warn("ui", "objectness windows for the live view failed", {{"error", e.what()}});
+    }
+    std::lock_guard<std::mutex> l(L.m);
+    if (L.detections_seq == seq) {
+      L.windows_boxes = windows;
+      L.windows_seq = seq;
+    }
+  }
+  if (img.type() == CV_8UC1) cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
+  const double fs = std::max(0.4, img.cols / 1000.0);
+  for (const auto& w : windows) cv::rectangle(img, w, cv::Scalar(230, 200, 60), 1, cv::LINE_AA);
+  for (size_t i = 0; i < dets.size(); ++i) {
+    const auto& d = dets[i];
+    // The best detection (what the executive servos on) thick green, the others amber.
+    const cv::Scalar c = i == 0 ? cv::Scalar(40, 200, 40) : cv::Scalar(0, 170, 255);
+    cv::rectangle(img, d.window, c, i == 0 ? 3 : 2);
+    char label[160];
+    std::snprintf(label, sizeof label, "%s  %d inl", d.class_name.c_str(), d.inliers);
+    int base = 0;
+    const cv::Size ts = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, fs, 1, &base);
+    const cv::Point org(d.window.x, std::max(ts.height + 4, d.window.y - 4));
+    cv::rectangle(img, org + cv::Point(-2, base), org + cv::Point(ts.width + 2, -ts.height - 2), c,
+                  cv::FILLED);
+    cv::putText(img, label, org, cv::FONT_HERSHEY_SIMPLEX, fs, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  }
+  std::vector<unsigned char> buf;
+  cv::imencode(".jpg", img, buf, {cv::IMWRITE_JPEG_QUALITY, 80});
+  return buf;
+}
+
+Json RunController::capture(const std::string& class_name, const std::optional<cv::Rect>& box) {
+  const std::string cls = safeClassName(class_name);
+  if (opt_.capture_dir.empty()) throw InputError("capture: no landmark folder configured");
+  cv::Mat img;
+  {
+    std::lock_guard<std::mutex> l(live_->m);
+    if (live_->frame.empty())
+      throw InputError("capture: no camera frame yet (start a run to open the camera)");
+    // The frame on the page, so a box dragged on it frames what the user saw.
+    img = (showObserved(*live_) ? live_->obs_frame : live_->frame).clone();
+  }
+  if (box) {
+    const cv::Rect r = *box & cv::Rect(0, 0, img.cols, img.rows);
+    if (r.width < 16 || r.height < 16)
+      throw InputError("capture: the box must be at least 16x16 pixels inside the frame");
+    img = img(r).clone();
+  }
+  const fs::path dir = fs::path(opt_.capture_dir) / cls;
+  fs::create_directories(dir);
+  // Next free number: never overwrite an earlier capture.
+  int n = 1;
+  static const std::regex num(R"(capture_(\d+)\.jpg)");
+  for (const auto& e : fs::directory_iterator(dir)) {
+    std::smatch m;
+    const std::string name = e.path().filename().string();
+    if (std::regex_match(name, m, num)) n = std::max(n, std::stoi(m[1]) + 1);
+  }
+  const fs::path file = dir / ("capture_" + std::to_string(n) + ".jpg");
+  if (!cv::imwrite(file.string(), img, {cv::IMWRITE_JPEG_QUALITY, 95}))
+    throw RuntimeError("capture: cannot write " + file.string());
+  log::info("ui", "captured a landmark photo", {{"file", file.string()}});
+  return {{"file", file.string()},
+          {"class", cls},
+          {"width", img.cols},
+          {"height", img.rows},
+          {"new_class", n == 1}};
+}
+
+// ---- routes --------------------------------------------------------------------------------
+
+void addRunRoutes(Server& server, RunController& rc) {
+  auto parse = [](const httplib::Request& req) {
+    if (req.body.empty()) return Json::object();
+    return Json::parse(req.body);
+  };
+  server.post("/api/run/start", [&rc, parse](const httplib::Request& req, httplib::Response& res) {
+    const RunRequest r = RunRequest::fromJson(parse(req));
+    rc.start(r);
+    sendJson(res, rc.state());
+  });
+  server.post("/api/run/stop", [&rc](const httplib::Request&, httplib::Response& res) {
+    const bool was_running = rc.stop();
+    Json s = rc.state();
+    s["stopped"] = was_running;
+    sendJson(res, s);
+  });
+  server.get("/api/run/state",
+             [&rc](const httplib::Request&, httplib::Response& res) { sendJson(res, rc.state()); });
+  server.get("/api/run/map",
+             [&rc](const httplib::Request&, httplib::Response& res) { sendJson(res, rc.map()); });
+  server.get("/api/run/frame.jpg", [&rc](const httplib::Request&, httplib::Response& res) {
+    const auto jpg = rc.frameJpeg();
+    if (jpg.empty()) return sendError(res, 404, "no camera frame yet");
+    res.set_content(std::string(jpg.begin(), jpg.end()), "image/jpeg");
+  });
+  server.get("/api/run/worlds", [&rc](const httplib::Request&, httplib::Response& res) {
+    sendJson(res, {{"worlds", rc.options().worlds}, {"sketches", rc.options().sketches}});
+  });
+  server.post("/api/capture", [&rc, parse](const httplib::Request& req, httplib::Response& res) {
+    const Json j = parse(req);
+    if (!j.contains("class") || !j["class"].is_string())
+      throw InputError("capture: 'class' (a landmark class name) is required");
+    std::optional<cv::Rect> box;
+    if (j.contains("box") && !j["box"].is_null()) {
+      const Json& b = j["box"];
+      if (!b.is_array() || b.size() != 4)
+        throw InputError("capture: 'box' must be [x, y, width, height] in frame pixels");
+      for (const auto& v : b)
+        if (!v.is_number()) throw InputError("capture: 'box' values must be numbers");
+      box = cv::Rect(static_cast<int>(std::lround(b[0].get<double>())),
+                     static_cast<int>(std::lround(b[1].get<double>())),
+                     static_cast<int>(std::lround(b[2].get<double>())),
+                     static_cast<int>(std::lround(b[3].get<double>())));
+    }
+    sendJson(res, rc.capture(j["class"].get<std::string>(), box));
+  });
+}
+
+}  // namespace sketchnav::ui

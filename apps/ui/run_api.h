@@ -1,0 +1,132 @@
+#pragma once
+// The live run page of `sketchnav ui` (doc/ui.md, "Run page"): starts one navigation run on a
+// background thread, keeps what the page shows (state, latest camera frame with the
+// recognised landmarks, map geometry and the trajectory), stops it on request and saves
+// camera captures into the landmark set.
+//
+// The run itself is not done here: a Runner (in the command, `sketchnav run`'s harness) is
+// handed RunHooks and reports through them. That keeps this library free of the simulator
+// and the vision stack, and lets the HTTP tests drive the page's API with a scripted runner.
+//
+//   POST /api/run/start   {world, sketch, robot, camera, laser, sonar, seed, max_time_s,
+//                          camera_only}
+//   POST /api/run/stop    stops the base at once, then ends the run ("stopped by user")
+//   GET  /api/run/state   status, section k/n, mode, turn, v, w, pose, landmarks, health...
+//   GET  /api/run/frame.jpg  latest camera frame, detections drawn (404 before the first)
+//   GET  /api/run/map     map geometry (odometry frame) and the trajectory so far
+//   POST /api/capture     {class, box?: [x, y, w, h]} -> <capture dir>/<class>/capture_<n>.jpg
+//   GET  /api/run/worlds  simulated worlds and sketches the page offers
+// Eigen-using headers (through nav) before httplib.h (server.h): a macro of httplib's breaks
+// Eigen's headers.
+#include "sketchnav/nav/executive.h"
+#include "sketchnav/nav/perception.h"
+// clang-format off
+#include <opencv2/core/mat.hpp>
+
+#include <atomic>
+#include <condition_variable>
+#include <deque>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <optional>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "server.h"
+#include "sketchnav/core/config.h"
+#include "sketchnav/hw/devices.h"
+// clang-format on
+
+namespace sketchnav::ui {
+
+/// What the page asks for. Any of robot/camera/laser/sonar set -> the real robot; otherwise
+/// the simulator with `world` (a name in share/worlds or a world file).
+struct RunRequest {
+  std::string world = "corridor";
+  std::string sketch;  // "" = the world's own sketch
+  std::string robot, camera, laser, sonar;
+  int seed = 1;
+  double max_time_s = 0;     // > 0 caps the run
+  bool camera_only = false;  // open `camera` only and show its frames (capturing, no driving)
+  bool hardware() const {
+    return !robot.empty() || !camera.empty() || !laser.empty() || !sonar.empty();
+  }
+  /// From the POST body; InputError naming the bad field.
+  static RunRequest fromJson(const Json& j);
+  Json toJson() const;
+};
+
+/// How a runner reports to the page. All are set by RunController and called on the run's
+/// thread.
+struct RunHooks {
+  std::function<void(const Json&)> on_event;              // executive events
+  std::function<void(const nav::TelemetryRow&)> on_tick;  // every control tick
+  std::function<void(const hw::Frame&, const nav::Observation&)> on_observation;
+  std::function<std::unique_ptr<hw::Camera>(std::unique_ptr<hw::Camera>)> wrap_camera;
+  std::function<std::unique_ptr<hw::Base>(std::unique_ptr<hw::Base>)> wrap_base;
+  std::function<bool()> stop_requested;     // polled every tick: true -> stop and end the run
+  std::function<void(const Json&)> on_map;  // map geometry, once before the run starts
+};
+
+/// Runs one navigation to the end (or until stop_requested()), returns its summary. Throws
+/// InputError / RuntimeError like runNavigation().
+using Runner = std::function<Json(const RunRequest&, const RunHooks&)>;
+
+struct RunApiOptions {
+  Runner runner;
+  std::string capture_dir;            // where captures go: one folder per class (the landmark set)
+  std::vector<std::string> worlds;    // offered on the page (names)
+  std::vector<std::string> sketches;  // offered on the page (paths or names)
+  /// The objectness windows perception examined in a frame, drawn on the live view; computed
+  /// on demand (only while someone watches), optional.
+  std::function<std::vector<cv::Rect>(const cv::Mat&)> propose_windows;
+};
+
+/// A landmark class name a capture may create: letters, digits, '_', '-', '.', ' ', no
+/// leading dot or space, at most 80 characters. InputError otherwise.
+std::string safeClassName(const std::string& name);
+
+class RunController {
+ public:
+  explicit RunController(RunApiOptions options);
+  /// Stops a run still going and waits for it.
+  ~RunController();
+  RunController(const RunController&) = delete;
+  RunController& operator=(const RunController&) = delete;
+
+  /// Starts a run on the background thread. InputError when one is already going.
+  void start(const RunRequest& request);
+  /// Stops the base at once (real robot: from this thread; simulator: at its next command),
+  /// then the run ends with "stopped by user". Returns false when no run was going.
+  bool stop();
+  /// Waits for the run thread to finish (tests, shutdown).
+  void join();
+
+  Json state() const;
+  Json map() const;
+  /// JPEG of the frame shown (the last one perception examined while it is recent, else the
+  /// latest) with the objectness windows and the detections drawn; empty before any frame.
+  std::vector<unsigned char> frameJpeg() const;
+  /// Saves the frame shown (or the box [x, y, w, h] of it, in its pixels) into
+  /// <capture_dir>/<class>/capture_<n>.jpg. Returns {file, class, width, height}.
+  Json capture(const std::string& class_name, const std::optional<cv::Rect>& box);
+
+  const RunApiOptions& options() const { return opt_; }
+
+  // Called by the hooks (public for the wrappers in run_api.cpp).
+  struct Live;
+
+ private:
+  void runThread(RunRequest request);
+  RunApiOptions opt_;
+  std::shared_ptr<Live> live_;
+  std::thread thread_;
+  std::mutex start_mutex_;
+};
+
+/// Registers the routes above on `server` (the controller must outlive it).
+void addRunRoutes(Server& server, RunController& controller);
+
+}  // namespace sketchnav::ui

@@ -1,0 +1,88 @@
+#pragma once
+// The local web server behind `sketchnav ui`: static pages plus a JSON API, guarded so only
+// the page it serves can drive it. Other areas add their routes (e.g. a live-run page and
+// control endpoints) with get()/post()/put()/del(): every route gets the same guards
+// (Host/Origin check, body size limit) and the same error mapping (InputError -> 400 with
+// {"error": "..."}, anything else -> 500), so a new endpoint is safe by default.
+//
+// Threading: httplib serves requests from a thread pool; handlers must be thread-safe.
+#include <httplib.h>
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/config.h"
+
+namespace sketchnav::ui {
+
+struct ServerOptions {
+  std::string host = "127.0.0.1";         // bind address; only loopback unless the user says so
+  int port = 8080;                        // 0 = any free port (tests)
+  std::string web_root;                   // static files; "" = none
+  std::size_t max_body_bytes = 5u << 20;  // larger request bodies get 413
+  std::vector<std::string> extra_hosts;   // more Host names to accept (e.g. "robot.local")
+};
+
+using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
+
+class Server {
+ public:
+  explicit Server(ServerOptions options);
+  ~Server();
+  Server(const Server&) = delete;
+  Server& operator=(const Server&) = delete;
+
+  // Patterns are httplib regexes, e.g. R"(/api/sketches/([^/]+))" (captures in req.matches).
+  void get(const std::string& pattern, Handler h);
+  void post(const std::string& pattern, Handler h);
+  void put(const std::string& pattern, Handler h);
+  void del(const std::string& pattern, Handler h);
+
+  /// Binds the socket; returns the port (useful with port 0). RuntimeError when it cannot.
+  int bind();
+  /// Serves until stop(); call bind() first. Blocks.
+  void serve();
+  /// Safe from another thread or a signal-watching thread.
+  void stop();
+  bool running() const;
+
+  int port() const { return port_; }
+  /// "http://127.0.0.1:8080/"
+  std::string url() const;
+  /// True when a request with these headers may use the API (exposed for tests).
+  bool hostAllowed(const std::string& host_header) const;
+  bool originAllowed(const std::string& origin_header) const;
+
+ private:
+  Handler wrap(Handler h) const;
+  ServerOptions opt_;
+  std::unique_ptr<httplib::Server> http_;
+  int port_ = 0;
+};
+
+/// Response helpers for handlers.
+void sendJson(httplib::Response& res, const Json& j, int status = 200);
+void sendError(httplib::Response& res, int status, const std::string& message);
+
+/// The sketch editor's API (doc/ui.md):
+///   GET  /api/classes                       landmark classes [{name, thumbnail}]
+///   GET  /api/classes/<name>/thumbnail      an image of that class
+///   GET  /api/sketches                      sketches in the sketch directory + shipped examples
+///   GET  /api/sketches/<file>               one sketch (from the sketch directory)
+///   GET  /api/examples/<file>               one shipped example sketch (read-only)
+///   POST /api/sketches/<file>               validate and save (file name only, no path)
+///   POST /api/route                         sketch -> route (the live preview)
+struct EditorOptions {
+  std::string landmarks_dir;  // the landmark set: one folder per class
+  std::string sketch_dir;     // where sketches are opened from and saved to
+  std::string examples_dir;   // shipped examples (read-only); "" = none
+};
+void addEditorRoutes(Server& server, const EditorOptions& options);
+
+/// A sketch file name a user may save to: letters, digits, '_', '-', '.', no leading dot,
+/// at most 100 characters; ".sketch.json" is appended when missing. InputError otherwise.
+std::string safeSketchFileName(const std::string& name);
+
+}  // namespace sketchnav::ui

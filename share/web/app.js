@@ -1,0 +1,572 @@
+// sketchnav sketch editor: plain JS + SVG, no build step. The server owns validation and the
+// sketch -> route conversion (POST /api/route); this page only edits and draws.
+'use strict';
+
+let W = 1000, H = 700;              // canvas size [canvas px], stored in the file
+const SVGNS = 'http://www.w3.org/2000/svg';
+const $ = (id) => document.getElementById(id);
+
+const state = {
+  name: '',
+  landmarks: [],        // {id, cls, x, y, w, h, distance}
+  path: [],             // [[x, y], ...]
+  start: null, goal: null,
+  startSet: false, goalSet: false,  // set by the user (otherwise they follow the path's ends)
+};
+let classes = [];          // [{name, thumbnail}]
+let selectedClass = null;  // palette selection
+let selectedId = null;     // selected landmark
+let tool = 'select';
+let history = [];
+let route = null;          // last converted route (server JSON)
+let routeError = '';
+let drag = null;           // current pointer interaction
+let dirty = false;         // edits since the last save / open
+let savedFiles = [];       // sketches in the sketch directory (to ask before overwriting)
+
+// ---------- helpers ----------
+function el(tag, attrs = {}, parent = null) {
+  const e = document.createElementNS(SVGNS, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (parent) parent.appendChild(e);
+  return e;
+}
+const r1 = (v) => Math.round(v * 10) / 10;
+const clamp = (v, a, b) => Math.max(a, Math.min(b, v));
+
+function setStatus(text, kind = '') {
+  const s = $('status');
+  s.textContent = text;
+  s.className = kind;
+}
+
+function snapshot() { return JSON.stringify({ ...state, W, H }); }
+function pushHistory() {
+  history.push(snapshot());
+  if (history.length > 200) history.shift();
+  $('undo').disabled = false;
+}
+function undo() {
+  if (!history.length) return;
+  const prev = JSON.parse(history.pop());
+  setCanvasSize(prev.W, prev.H);
+  delete prev.W; delete prev.H;
+  Object.assign(state, prev);
+  if (!state.landmarks.some((l) => l.id === selectedId)) selectedId = null;
+  $('undo').disabled = history.length === 0;
+  changed();
+  setStatus('Undone.');
+}
+
+function toCanvas(evt) {
+  const svg = $('canvas');
+  const pt = svg.createSVGPoint();
+  pt.x = evt.clientX; pt.y = evt.clientY;
+  const p = pt.matrixTransform(svg.getScreenCTM().inverse());
+  return [clamp(p.x, 0, W), clamp(p.y, 0, H)];
+}
+
+function nextId() {
+  let n = 0;
+  for (const l of state.landmarks) {
+    const m = /^L(\d+)$/.exec(l.id);
+    if (m) n = Math.max(n, +m[1]);
+  }
+  return 'L' + (n + 1);
+}
+
+function startPoint() { return state.start || (state.path.length ? state.path[0] : null); }
+function goalPoint() { return state.goal || (state.path.length ? state.path[state.path.length - 1] : null); }
+
+// ---------- the file format (doc/sketch-format.md) ----------
+function toSketchJson() {
+  return {
+    format: 1,
+    name: state.name || '',
+    canvas: { width: W, height: H },
+    landmarks: state.landmarks.map((l) => ({
+      id: l.id, class: l.cls,
+      rect: { x: r1(l.x), y: r1(l.y), w: r1(l.w), h: r1(l.h) },
+      distance_m: l.distance,
+    })),
+    path: state.path.map(([x, y]) => [r1(x), r1(y)]),
+    start: (startPoint() || [0, 0]).map(r1),
+    goal: (goalPoint() || [0, 0]).map(r1),
+  };
+}
+
+function setCanvasSize(w, h) {
+  W = w; H = h;
+  $('canvas').setAttribute('viewBox', `0 0 ${w} ${h}`);
+  $('bg').setAttribute('width', w);
+  $('bg').setAttribute('height', h);
+}
+
+function fromSketchJson(j) {
+  setCanvasSize(j.canvas.width, j.canvas.height);
+  state.name = j.name || '';
+  state.landmarks = j.landmarks.map((l) => ({
+    id: l.id, cls: l.class, x: l.rect.x, y: l.rect.y, w: l.rect.w, h: l.rect.h, distance: l.distance_m,
+  }));
+  state.path = j.path.map((p) => [p[0], p[1]]);
+  state.start = j.start; state.goal = j.goal;
+  state.startSet = state.goalSet = true;
+  selectedId = null;
+}
+
+// ---------- drawing ----------
+function render() {
+  renderPath();
+  renderRoute();
+  renderLandmarks();
+  renderMarks();
+  renderPanels();
+}
+
+function renderPath() {
+  const g = $('layer-path');
+  g.replaceChildren();
+  if (state.path.length > 1)
+    el('polyline', { class: 'raw-path', points: state.path.map((p) => p.join(',')).join(' ') }, g);
+}
+
+function routeToCanvas(m) {
+  const s = startPoint();
+  return [s[0] + m[0] / route.scale_m_per_px, s[1] - m[1] / route.scale_m_per_px];
+}
+
+function renderRoute() {
+  const g = $('layer-route');
+  g.replaceChildren();
+  $('layer-guides').replaceChildren();
+  if (!route || !$('show-route').checked || !startPoint()) return;
+  route.sections.forEach((sec, i) => {
+    const a = routeToCanvas(sec.start_m), b = routeToCanvas(sec.end_m);
+    el('line', { class: 'section ' + (i % 2 ? 'odd' : 'even'), x1: a[0], y1: a[1], x2: b[0], y2: b[1] }, g);
+    const len = Math.hypot(sec.end_m[0] - sec.start_m[0], sec.end_m[1] - sec.start_m[1]) || 1;
+    for (const l of sec.landmarks) {  // where along the section each landmark is passed
+      const u = [(sec.end_m[0] - sec.start_m[0]) / len, (sec.end_m[1] - sec.start_m[1]) / len];
+      const at = routeToCanvas([sec.start_m[0] + u[0] * l.along_m, sec.start_m[1] + u[1] * l.along_m]);
+      const p = routeToCanvas(l.position_m);
+      el('line', { class: 'pass', x1: at[0], y1: at[1], x2: p[0], y2: p[1] }, g);
+    }
+  });
+  route.guide_points_m.forEach((m, i) => {
+    const c = routeToCanvas(m);
+    const gg = el('g', { class: 'guide' }, $('layer-guides'));
+    el('circle', { cx: c[0], cy: c[1], r: 10 }, gg);
+    const t = el('text', { x: c[0], y: c[1] + 4 }, gg);
+    t.textContent = String(i);
+  });
+}
+
+function orderOf(id) {
+  if (!route) return null;
+  for (const s of route.sections) for (const l of s.landmarks) if (l.id === id) return l.order;
+  return null;
+}
+
+function renderLandmarks() {
+  const g = $('layer-landmarks');
+  g.replaceChildren();
+  for (const l of state.landmarks) {
+    const gg = el('g', { class: 'lm' + (l.id === selectedId ? ' selected' : ''), 'data-id': l.id }, g);
+    el('rect', { class: 'box', x: l.x, y: l.y, width: l.w, height: l.h, rx: 4 }, gg);
+    const c = classes.find((k) => k.name === l.cls);
+    if (c && l.w > 24 && l.h > 24)
+      el('image', { href: c.thumbnail, x: l.x + 3, y: l.y + 3, width: l.w - 6, height: l.h - 6,
+                    preserveAspectRatio: 'xMidYMid meet', opacity: 0.85, 'pointer-events': 'none' }, gg);
+    const t = el('text', { x: l.x, y: l.y - 6 }, gg);
+    t.textContent = `${l.id} · ${l.cls}`;
+    const d = el('text', { class: 'dist', x: l.x, y: l.y + l.h + 15 }, gg);
+    d.textContent = `${l.distance} m`;
+    const order = orderOf(l.id);
+    if (order !== null && $('show-route').checked) {
+      const b = el('g', { class: 'badge' }, gg);
+      el('circle', { cx: l.x + l.w, cy: l.y, r: 11 }, b);
+      const bt = el('text', { x: l.x + l.w, y: l.y + 4 }, b);
+      bt.textContent = String(order + 1);
+    }
+    if (l.id === selectedId)
+      el('rect', { class: 'handle', x: l.x + l.w - 7, y: l.y + l.h - 7, width: 14, height: 14, 'data-handle': '1' }, gg);
+  }
+}
+
+function renderMarks() {
+  const g = $('layer-marks');
+  g.replaceChildren();
+  const s = startPoint(), e = goalPoint();
+  if (s) {
+    el('circle', { class: 'mark-start', cx: s[0], cy: s[1], r: 14 }, g);
+    const t = el('text', { class: 'mark-label', x: s[0] + 16, y: s[1] + 22, fill: '#1f9d55' }, g);
+    t.textContent = 'start';
+  }
+  if (e) {
+    el('circle', { class: 'mark-goal', cx: e[0], cy: e[1], r: 14 }, g);
+    const t = el('text', { class: 'mark-label', x: e[0] + 16, y: e[1] + 22, fill: '#c62828' }, g);
+    t.textContent = 'goal';
+  }
+}
+
+const deg = (r) => Math.round((r * 180) / Math.PI);
+
+function renderPanels() {
+  // Route summary and sections.
+  const sum = $('route-summary'), warn = $('route-warnings'), body = $('route-sections').tBodies[0];
+  warn.replaceChildren();
+  body.replaceChildren();
+  if (route) {
+    sum.className = '';
+    sum.textContent = `${route.sections.length} section(s), ${route.total_length_m.toFixed(1)} m; ` +
+      `scale ${(route.scale_m_per_px * 100).toFixed(2)} m per 100 px; ` +
+      `distance residual ${(route.scale_residual * 100).toFixed(0)} %`;
+    for (const w of route.warnings) { const li = document.createElement('li'); li.textContent = w; warn.appendChild(li); }
+    for (const s of route.sections) {
+      const tr = body.insertRow();
+      tr.insertCell().textContent = s.index;
+      tr.insertCell().textContent = s.length_m.toFixed(1) + ' m';
+      const turn = deg(s.heading_change_rad);
+      tr.insertCell().textContent = s.index === 0 ? '—' : (turn > 0 ? `${turn}° L` : turn < 0 ? `${-turn}° R` : '0°');
+      const cell = tr.insertCell();
+      if (!s.landmarks.length) cell.textContent = '—';
+      for (const l of s.landmarks) {
+        const div = document.createElement('div');
+        div.innerHTML = `<b>${l.order + 1}.</b> `;
+        div.append(`${l.class} (${l.id}) `);
+        const side = document.createElement('span');
+        side.className = 'side-' + l.side;
+        side.textContent = `${l.side} ${l.range_m.toFixed(1)} m`;
+        div.append(side, ` @ ${l.along_m.toFixed(1)} m`);
+        cell.appendChild(div);
+      }
+    }
+  } else {
+    sum.className = 'hint';
+    sum.textContent = routeError || 'Add landmarks and draw a path from the start to the goal.';
+  }
+  // Landmark list with editable distances.
+  const lb = $('landmark-list').tBodies[0];
+  lb.replaceChildren();
+  for (const l of state.landmarks) {
+    const tr = lb.insertRow();
+    tr.insertCell().textContent = l.id;
+    tr.insertCell().textContent = l.cls;
+    const inp = document.createElement('input');
+    inp.type = 'number'; inp.min = '0.1'; inp.step = '0.1'; inp.value = l.distance;
+    inp.addEventListener('change', () => {
+      const v = parseFloat(inp.value);
+      if (!(v > 0 && v <= 1000)) { setStatus('A distance must be between 0.1 and 1000 m.', 'error'); inp.value = l.distance; return; }
+      pushHistory(); l.distance = v; changed();
+    });
+    tr.insertCell().appendChild(inp);
+    tr.addEventListener('click', () => { selectedId = l.id; render(); });
+  }
+  $('delete').disabled = !selectedId;
+  $('add').disabled = !selectedClass;
+}
+
+// ---------- live route ----------
+let routeTimer = null, routeSeq = 0;
+function changed(edit = true) {
+  if (edit) dirty = true;
+  render();
+  clearTimeout(routeTimer);
+  routeTimer = setTimeout(updateRoute, 120);
+}
+
+async function updateRoute() {
+  if (!state.landmarks.length || state.path.length < 2) {
+    route = null;
+    routeError = !state.landmarks.length ? 'Add at least one landmark.' : 'Draw the guide path (Draw path tool).';
+    render();
+    return;
+  }
+  const seq = ++routeSeq;
+  try {
+    const res = await fetch('api/route', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                           body: JSON.stringify(toSketchJson()) });
+    const j = await res.json();
+    if (seq !== routeSeq) return;  // a newer edit is already being converted
+    if (res.ok) { route = j; routeError = ''; }
+    else { route = null; routeError = j.error || `error ${res.status}`; }
+  } catch (e) {
+    if (seq !== routeSeq) return;
+    route = null; routeError = 'server not reachable: ' + e.message;
+  }
+  render();
+}
+
+// ---------- landmarks ----------
+function askDistance(title, initial) {
+  return new Promise((resolve) => {
+    const dlg = $('dist-dialog');
+    $('dist-title').textContent = title;
+    $('dist-input').value = initial ?? '';
+    dlg.returnValue = '';
+    dlg.onclose = () => {
+      const v = parseFloat($('dist-input').value);
+      resolve(dlg.returnValue === 'ok' && v > 0 && v <= 1000 ? Math.round(v * 10) / 10 : null);
+    };
+    dlg.showModal();
+    $('dist-input').focus();
+    $('dist-input').select();
+  });
+}
+
+async function addLandmark() {
+  if (!selectedClass) { setStatus('Pick a landmark class first.', 'error'); return; }
+  // New landmarks appear in a free-ish spot near the centre, staggered so they do not stack.
+  const k = state.landmarks.length % 6;
+  const lm = { id: nextId(), cls: selectedClass, x: W / 2 - 80 + 30 * k, y: H / 2 - 60 + 25 * k, w: 110, h: 80, distance: null };
+  const d = await askDistance(`Distance for ${lm.id} (${lm.cls})`, '');
+  if (d === null) { setStatus('Add cancelled.'); return; }
+  lm.distance = d;
+  pushHistory();
+  state.landmarks.push(lm);
+  selectedId = lm.id;
+  setTool('select');
+  changed();
+  setStatus(`Added ${lm.id}. Drag it to its place.`);
+}
+
+async function editDistance(id) {
+  const l = state.landmarks.find((x) => x.id === id);
+  if (!l) return;
+  const d = await askDistance(`Distance for ${l.id} (${l.cls})`, l.distance);
+  if (d === null) return;
+  pushHistory();
+  l.distance = d;
+  changed();
+}
+
+function deleteSelected() {
+  if (!selectedId) return;
+  pushHistory();
+  state.landmarks = state.landmarks.filter((l) => l.id !== selectedId);
+  setStatus(`Deleted ${selectedId}.`);
+  selectedId = null;
+  changed();
+}
+
+// ---------- pointer interaction ----------
+function onPointerDown(evt) {
+  if (evt.button !== 0) return;
+  const p = toCanvas(evt);
+  const target = evt.target;
+  const lmNode = target.closest && target.closest('.lm');
+  if (tool === 'select') {
+    if (lmNode) {
+      const l = state.landmarks.find((x) => x.id === lmNode.dataset.id);
+      selectedId = l.id;
+      drag = { kind: target.dataset.handle ? 'resize' : 'move', l, from: p, orig: { ...l }, saved: snapshot(), moved: false };
+    } else {
+      selectedId = null;
+    }
+    render();
+  } else if (tool === 'path') {
+    const saved = snapshot();
+    const end = state.path[state.path.length - 1];
+    // Pressing near the end of the existing path continues it; elsewhere starts a new one.
+    if (!(end && Math.hypot(end[0] - p[0], end[1] - p[1]) < 25)) state.path = [p];
+    drag = { kind: 'path', saved };
+  } else if (tool === 'start' || tool === 'goal') {
+    pushHistory();
+    state[tool] = p;
+    state[tool === 'start' ? 'startSet' : 'goalSet'] = true;
+    changed();
+    setStatus(`${tool === 'start' ? 'Start' : 'Goal'} set.`);
+  }
+  if (drag) $('canvas').setPointerCapture(evt.pointerId);
+}
+
+function onPointerMove(evt) {
+  if (!drag) return;
+  const p = toCanvas(evt);
+  if (drag.kind === 'path') {
+    const last = state.path[state.path.length - 1];
+    if (Math.hypot(last[0] - p[0], last[1] - p[1]) >= 3 && state.path.length < 20000) {
+      state.path.push(p);
+      if (!state.startSet) state.start = null;
+      if (!state.goalSet) state.goal = null;
+      renderPath(); renderMarks();
+    }
+    return;
+  }
+  const dx = p[0] - drag.from[0], dy = p[1] - drag.from[1];
+  if (Math.abs(dx) + Math.abs(dy) > 1) drag.moved = true;
+  const l = drag.l, o = drag.orig;
+  if (drag.kind === 'move') {
+    l.x = clamp(o.x + dx, -o.w / 2, W - o.w / 2);
+    l.y = clamp(o.y + dy, -o.h / 2, H - o.h / 2);
+  } else {
+    l.w = clamp(o.w + dx, 20, W);
+    l.h = clamp(o.h + dy, 20, H);
+  }
+  renderLandmarks();
+}
+
+function onPointerUp() {
+  if (!drag) return;
+  const d = drag;
+  drag = null;
+  if (d.kind === 'path') {
+    if (state.path.length < 2) { state.path = JSON.parse(d.saved).path; setStatus('Press and drag to draw the path.'); render(); return; }
+    history.push(d.saved); $('undo').disabled = false;
+    setStatus(`Path: ${state.path.length} points.`);
+    changed();
+  } else if (d.moved) {
+    history.push(d.saved); $('undo').disabled = false;
+    changed();
+  }
+}
+
+function setTool(t) {
+  tool = t;
+  document.querySelectorAll('.tool').forEach((b) => b.classList.toggle('active', b.dataset.tool === t));
+  $('canvas').setAttribute('class', 'mode-' + t);
+  const tips = { select: 'Move: drag landmarks, drag the orange corner to resize, double-click to edit the distance.',
+                 path: 'Draw path: press and drag from the start to the goal. Press near the end of the path to continue it.',
+                 start: 'Click where the robot starts.', goal: 'Click where the robot should arrive.' };
+  setStatus(tips[t]);
+}
+
+// ---------- files ----------
+async function api(path, opts) {
+  const res = await fetch(path, opts);
+  let j = null;
+  try { j = await res.json(); } catch (e) { j = { error: `HTTP ${res.status}` }; }
+  return { ok: res.ok, status: res.status, j };
+}
+
+async function refreshFileList(selectValue = '') {
+  const { ok, j } = await api('api/sketches');
+  if (!ok) return;
+  savedFiles = j.files;
+  const sel = $('open');
+  sel.replaceChildren(new Option('Open…', ''));
+  const add = (label, list, prefix) => {
+    if (!list.length) return;
+    const g = document.createElement('optgroup');
+    g.label = label;
+    for (const f of list) g.appendChild(new Option(f, prefix + f));
+    sel.appendChild(g);
+  };
+  add('Sketch directory', j.files, 'sketches/');
+  add('Examples (read-only)', j.examples, 'examples/');
+  sel.value = selectValue;
+}
+
+async function openSketch(value) {
+  if (!value) return;
+  if (dirty && !confirm('Discard the unsaved changes?')) return;
+  const { ok, j } = await api('api/' + value.split('/').map(encodeURIComponent).join('/'));
+  if (!ok) { setStatus(j.error, 'error'); return; }
+  pushHistory();
+  fromSketchJson(j);
+  const file = value.split('/').pop();
+  $('name').value = value.startsWith('examples/') ? '' : file.replace(/\.sketch\.json$/, '');
+  changed(false);
+  dirty = false;
+  setStatus(`Opened ${file}.`, 'ok');
+}
+
+async function save() {
+  const name = $('name').value.trim();
+  if (!name) { setStatus('Type a file name first.', 'error'); $('name').focus(); return; }
+  state.name = state.name || name;
+  const body = JSON.stringify(toSketchJson());
+  const url = 'api/sketches/' + encodeURIComponent(name);
+  const file = name.endsWith('.sketch.json') ? name : name + '.sketch.json';
+  let overwrite = '';
+  if (savedFiles.includes(file)) {
+    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return; }
+    overwrite = '?overwrite=1';
+  }
+  let r = await api(url + overwrite, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body });
+  if (r.status === 409) {  // saved meanwhile by someone else
+    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return; }
+    r = await api(url + '?overwrite=1', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body });
+  }
+  if (!r.ok) { setStatus('Not saved: ' + r.j.error, 'error'); return; }
+  dirty = false;
+  setStatus(`Saved ${r.j.path}`, 'ok');
+  refreshFileList('sketches/' + r.j.saved);
+}
+
+function newSketch() {
+  if (dirty && !confirm('Discard the unsaved changes?')) return;
+  pushHistory();
+  Object.assign(state, { name: '', landmarks: [], path: [], start: null, goal: null, startSet: false, goalSet: false });
+  setCanvasSize(1000, 700);
+  selectedId = null;
+  $('name').value = '';
+  changed();
+  setStatus('New sketch.');
+}
+
+// ---------- start-up ----------
+async function loadClasses() {
+  const { ok, j } = await api('api/classes');
+  if (!ok) { setStatus('Cannot load the landmark classes: ' + j.error, 'error'); return; }
+  classes = j.classes;
+  const pal = $('palette');
+  pal.replaceChildren();
+  for (const c of classes) {
+    const b = document.createElement('button');
+    b.className = 'class-card';
+    b.dataset.class = c.name;
+    b.title = c.name + ' (double-click to add)';
+    const img = document.createElement('img');
+    img.src = c.thumbnail; img.alt = '';
+    const span = document.createElement('span');
+    span.textContent = c.name;
+    b.append(img, span);
+    b.addEventListener('click', () => {
+      selectedClass = c.name;
+      pal.querySelectorAll('.class-card').forEach((x) => x.classList.toggle('selected', x === b));
+      $('add').disabled = false;
+    });
+    b.addEventListener('dblclick', addLandmark);
+    pal.appendChild(b);
+  }
+}
+
+function init() {
+  const svg = $('canvas');
+  svg.addEventListener('pointerdown', onPointerDown);
+  svg.addEventListener('pointermove', onPointerMove);
+  svg.addEventListener('pointerup', onPointerUp);
+  svg.addEventListener('pointercancel', onPointerUp);
+  svg.addEventListener('dblclick', (e) => {
+    const n = e.target.closest && e.target.closest('.lm');
+    if (n && tool === 'select') editDistance(n.dataset.id);
+  });
+  document.querySelectorAll('.tool').forEach((b) => b.addEventListener('click', () => setTool(b.dataset.tool)));
+  $('add').addEventListener('click', addLandmark);
+  $('undo').addEventListener('click', undo);
+  $('delete').addEventListener('click', deleteSelected);
+  $('clear-path').addEventListener('click', () => { if (!state.path.length) return; pushHistory(); state.path = []; changed(); });
+  $('show-route').addEventListener('change', render);
+  $('save').addEventListener('click', save);
+  $('new').addEventListener('click', newSketch);
+  $('open').addEventListener('change', (e) => { openSketch(e.target.value); e.target.value = ''; });
+  $('name').addEventListener('change', () => { state.name = $('name').value.trim(); });
+  document.addEventListener('keydown', (e) => {
+    if (e.target.tagName === 'INPUT' || $('dist-dialog').open) return;
+    if ((e.ctrlKey || e.metaKey) && e.key === 'z') { e.preventDefault(); undo(); }
+    else if ((e.ctrlKey || e.metaKey) && e.key === 's') { e.preventDefault(); save(); }
+    else if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
+    else if (e.key === 'v') setTool('select');
+    else if (e.key === 'p') setTool('path');
+    else if (e.key === 's') setTool('start');
+    else if (e.key === 'g') setTool('goal');
+  });
+  window.addEventListener('beforeunload', (e) => { if (dirty) { e.preventDefault(); e.returnValue = ''; } });
+  $('undo').disabled = true;
+  setTool('select');
+  render();
+  loadClasses().then(() => { render(); setStatus('Pick a landmark class on the left and press Add.'); });
+  refreshFileList();
+}
+
+init();

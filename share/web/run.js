@@ -1,0 +1,335 @@
+// The live run page: starts a run, polls its state (5 Hz), shows the camera with what
+// perception found, the command, the map with the robot's estimated pose, sensor health,
+// and captures landmark photos. The server does the work (doc/ui.md, "Run page").
+'use strict';
+
+const $ = (id) => document.getElementById(id);
+const SVGNS = 'http://www.w3.org/2000/svg';
+
+async function api(method, path, body) {
+  const opt = { method, headers: {} };
+  if (body !== undefined) {
+    opt.headers['Content-Type'] = 'application/json';
+    opt.body = JSON.stringify(body);
+  }
+  const res = await fetch(path, opt);
+  const ct = res.headers.get('Content-Type') || '';
+  const data = ct.includes('json') ? await res.json() : null;
+  if (!res.ok) throw new Error((data && data.error) || `HTTP ${res.status}`);
+  return data;
+}
+
+function message(el, text, kind) {
+  el.textContent = text;
+  el.className = 'hint' + (kind ? ' ' + kind : '');
+}
+
+// ---- setup ----------------------------------------------------------------------------
+function mode() { return document.querySelector('input[name=mode]:checked').value; }
+document.querySelectorAll('input[name=mode]').forEach((r) => r.addEventListener('change', () => {
+  $('sim-fields').hidden = mode() !== 'sim';
+  $('hw-fields').hidden = mode() !== 'hardware';
+}));
+
+async function loadChoices() {
+  try {
+    const w = await api('GET', '/api/run/worlds');
+    for (const name of w.worlds) $('world').append(new Option(name, name));
+    for (const s of w.sketches) $('sketch').append(new Option(s.replace(/^.*\//, ''), s));
+    if (w.worlds.includes('corridor')) $('world').value = 'corridor';
+  } catch (e) { message($('run-message'), 'Cannot list worlds: ' + e.message, 'error'); }
+  try {
+    const classes = await api('GET', '/api/classes');
+    for (const c of classes) $('class-list').append(new Option(c.name));
+  } catch (_) { /* the class list is only a convenience */ }
+}
+
+// ---- start / stop ---------------------------------------------------------------------
+async function start(req, what) {
+  $('start').disabled = true;
+  try {
+    await api('POST', '/api/run/start', req);
+    message($('run-message'), what);
+  } catch (e) {
+    message($('run-message'), e.message, 'error');
+  }
+  poll(true);
+}
+$('camera-only').addEventListener('click', () => {
+  start({ camera_only: true, camera: $('camera').value.trim() }, 'Opening the camera…');
+});
+$('start').addEventListener('click', async () => {
+  const req = { max_time_s: Number($('max-time').value) || 0 };
+  if (mode() === 'sim') {
+    req.world = $('world').value;
+    req.sketch = $('sketch').value;
+    req.seed = Math.max(0, Math.round(Number($('seed').value) || 0));
+  } else {
+    for (const k of ['robot', 'camera', 'laser', 'sonar']) req[k] = $(k).value.trim();
+    req.sketch = $('hw-sketch').value.trim();
+  }
+  start(req, 'Starting… (the first run trains the landmark model)');
+});
+
+async function stopRun() {
+  try {
+    await api('POST', '/api/run/stop', {});
+    message($('run-message'), 'Stop sent: the base is commanded to stop.');
+  } catch (e) {
+    message($('run-message'), 'STOP FAILED: ' + e.message, 'error');
+  }
+  poll(true);
+}
+$('stop').addEventListener('click', stopRun);
+document.addEventListener('keydown', (e) => {
+  if (e.key === 'Escape' && !$('stop').disabled) stopRun();
+});
+
+// ---- state ----------------------------------------------------------------------------
+let state = null;
+let frameSeq = -1;
+let frameLoading = false;
+const fmt = (v, d = 2) => (typeof v === 'number' ? v.toFixed(d) : '–');
+
+function describeEvent(e) {
+  const parts = [e.type];
+  if (e.id) parts.push(e.id + (e.class ? ` (${e.class})` : ''));
+  if (e.reason) parts.push(e.reason);
+  if (e.inliers) parts.push(`${e.inliers} inliers`);
+  if (e.type === 'section_done') parts.push(`${e.section + 1}/${e.of}`);
+  const t = typeof e.t === 'number' ? `${e.t.toFixed(1)}s ` : '';
+  return t + parts.join(' · ');
+}
+
+function render(s) {
+  state = s;
+  const badge = $('status-badge');
+  badge.textContent = s.status;
+  badge.className = 'badge-status ' + s.status;
+  $('start').disabled = s.active;
+  $('camera-only').disabled = s.active;
+  $('stop').disabled = !s.active;
+  $('capture-frame').disabled = !(s.frame_seq > 0);
+  $('capture-box').disabled = !(s.frame_seq > 0 && box);
+  if (!s.active && s.status !== 'idle') {
+    const txt = s.status === 'error' ? 'Run failed to start: ' + s.reason : `Run ${s.status}: ${s.reason}`;
+    message($('run-message'), txt, s.status === 'succeeded' ? 'ok' : s.status === 'stopped' ? '' : 'error');
+  } else if (s.status === 'running') {
+    message($('run-message'), 'Running.');
+  }
+  for (const el of document.querySelectorAll('#turn span')) el.classList.toggle('on', s.active && el.dataset.turn === s.turn);
+  $('w').textContent = fmt(s.w);
+  $('v').textContent = fmt(s.v);
+  $('section').textContent = s.sections ? `${s.section}/${s.sections}` : '–';
+  $('mode').textContent = s.mode || '–';
+  $('landmark').textContent = s.landmark || '–';
+  $('time').textContent = fmt(s.t, 1);
+  $('pose').textContent = s.pose ? `x ${fmt(s.pose.x)} y ${fmt(s.pose.y)} θ ${fmt(s.pose.theta * 180 / Math.PI, 0)}°` : '';
+
+  // Sensor health.
+  const h = s.health;
+  const rows = [
+    ['Camera', h.camera.ok, h.camera.open ? `${h.camera.frames} frames, ${h.camera.dropped} dropped${h.camera.last_error ? ' · ' + h.camera.last_error : ''}` : 'closed'],
+    ['Base', h.base.ok, h.base.open ? `sent v ${fmt(s.base.v)} ω ${fmt(s.base.w)} (${s.base.last})${h.base.last_error ? ' · ' + h.base.last_error : ''}` : 'closed'],
+    ['Range', h.range.front_free_m !== null && h.active, h.range.front_free_m !== null ? `${fmt(h.range.front_free_m)} m free ahead` : '–'],
+    ['Perception', s.perception.frame_seq > 0 && h.active, `${s.perception.windows} windows, ${s.perception.detections} found, ${fmt(s.perception.ms, 0)} ms`],
+  ];
+  $('health').replaceChildren(...rows.map(([name, ok, detail]) => {
+    const li = document.createElement('li');
+    li.dataset.sensor = name.toLowerCase();
+    const dot = document.createElement('span');
+    dot.className = 'dot ' + (h.active ? (ok ? 'ok' : 'bad') : '');
+    const n = document.createElement('span');
+    n.textContent = name;
+    const d = document.createElement('span');
+    d.className = 'detail';
+    d.textContent = detail;
+    li.append(dot, n, d);
+    return li;
+  }));
+
+  $('landmarks').replaceChildren(...s.landmarks.map((l) => {
+    const li = document.createElement('li');
+    const a = document.createElement('span');
+    a.textContent = `${l.id} · ${l.class || ''}`;
+    const b = document.createElement('span');
+    b.className = 'lm-state ' + l.state;
+    b.textContent = l.state + (l.inliers ? ` (${l.inliers})` : '');
+    li.append(a, b);
+    return li;
+  }));
+  $('events').replaceChildren(...s.events.slice().reverse().map((e) => {
+    const li = document.createElement('li');
+    li.textContent = describeEvent(e);
+    if (e.type === 'failed' || e.type === 'fault') li.className = 'fail';
+    return li;
+  }));
+
+  // A new frame: fetch it unless the previous one is still loading.
+  if (s.shown_seq > 0 && s.shown_seq !== frameSeq && !frameLoading && !dragFrom) {
+    frameLoading = true;
+    frameSeq = s.shown_seq;
+    $('camera-img').src = `/api/run/frame.jpg?seq=${s.shown_seq}`;
+  }
+}
+
+$('camera-img').addEventListener('load', () => {
+  frameLoading = false;
+  frameSize = [$('camera-img').naturalWidth, $('camera-img').naturalHeight];
+  $('camera-none').hidden = true;
+  sizeOverlay();
+});
+$('camera-img').addEventListener('error', () => { frameLoading = false; });
+
+let polling = false;
+async function poll(once) {
+  if (polling && once) return;
+  polling = true;
+  try {
+    render(await api('GET', '/api/run/state'));
+  } catch (e) {
+    message($('run-message'), 'Lost the server: ' + e.message, 'error');
+  } finally {
+    polling = false;
+  }
+}
+setInterval(poll, 200);
+
+// ---- map ------------------------------------------------------------------------------
+let geometryKey = '';
+function el(tag, attrs, parent) {
+  const e = document.createElementNS(SVGNS, tag);
+  for (const [k, v] of Object.entries(attrs)) e.setAttribute(k, v);
+  if (parent) parent.append(e);
+  return e;
+}
+const P = (p) => `${p[0]},${-p[1]}`;  // map y up -> SVG y down
+
+function drawGeometry(g, traj) {
+  const svg = $('map');
+  svg.replaceChildren();
+  const pts = [];
+  for (const k of ['floor', 'sketch_path']) for (const p of g[k] || []) pts.push(p);
+  for (const w of g.walls || []) pts.push(w.slice(0, 2), w.slice(2, 4));
+  for (const p of traj) pts.push(p);
+  pts.push([0, 0]);
+  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+  const x0 = Math.min(...xs) - 1, x1 = Math.max(...xs) + 1, y0 = Math.min(...ys) - 1, y1 = Math.max(...ys) + 1;
+  svg.setAttribute('viewBox', `${x0} ${-y1} ${x1 - x0} ${y1 - y0}`);
+  const unit = Math.max(x1 - x0, y1 - y0) / 60;
+  svg.dataset.unit = unit;
+  const base = el('g', { id: 'map-static' }, svg);
+  if (g.floor) el('polygon', { class: 'floor', points: g.floor.map(P).join(' '), 'vector-effect': 'non-scaling-stroke' }, base);
+  for (const o of g.obstacles || []) {
+    if (o.polygon) el('polygon', { class: 'obstacle', points: o.polygon.map(P).join(' ') }, base);
+    else el('circle', { class: 'obstacle', cx: o.x, cy: -o.y, r: o.r }, base);
+  }
+  for (const w of g.walls || []) el('line', { class: 'wall', x1: w[0], y1: -w[1], x2: w[2], y2: -w[3], 'stroke-width': Math.max(w[4] || 0.1, unit * 0.4) }, base);
+  if (g.goal) el('circle', { class: 'goal', cx: g.goal.x, cy: -g.goal.y, r: g.goal.r, 'vector-effect': 'non-scaling-stroke' }, base);
+  for (const l of g.world_landmarks || []) {
+    el('rect', { class: 'world-lm', x: l.x - unit * 0.7, y: -l.y - unit * 0.7, width: unit * 1.4, height: unit * 1.4 }, base).append(Object.assign(document.createElementNS(SVGNS, 'title'), { textContent: `${l.id} ${l.class} (real)` }));
+  }
+  if (g.sketch_path) el('polyline', { class: 'sketch-path', points: g.sketch_path.map(P).join(' '), 'vector-effect': 'non-scaling-stroke' }, base);
+  for (const l of g.sketch_landmarks || []) {
+    el('circle', { class: 'sketch-lm', cx: l.x, cy: -l.y, r: unit * 1.2, 'vector-effect': 'non-scaling-stroke' }, base);
+    const t = el('text', { class: 'sketch-lm-label', x: l.x + unit * 1.5, y: -l.y - unit * 1.2, 'font-size': unit * 3 }, base);
+    t.textContent = l.id + '?';
+  }
+  el('polyline', { id: 'map-traj', class: 'traj', points: '', 'vector-effect': 'non-scaling-stroke' }, svg);
+  el('polygon', { id: 'map-robot', class: 'robot', points: '', 'vector-effect': 'non-scaling-stroke' }, svg);
+}
+
+async function pollMap() {
+  try {
+    const m = await api('GET', '/api/run/map');
+    const key = JSON.stringify(m.geometry);
+    if (key !== geometryKey || !$('map-traj')) {
+      geometryKey = key;
+      drawGeometry(m.geometry || {}, m.trajectory);
+    }
+    $('map-traj').setAttribute('points', m.trajectory.map(P).join(' '));
+    const robot = $('map-robot');
+    if (m.pose) {
+      const u = Number($('map').dataset.unit) * 2.2, { x, y, theta: a } = m.pose;
+      const c = Math.cos(a), s = Math.sin(a);
+      const pts = [[1.4, 0], [-0.8, 0.8], [-0.8, -0.8]].map(([px, py]) => [x + u * (c * px - s * py), y + u * (s * px + c * py)]);
+      robot.setAttribute('points', pts.map(P).join(' '));
+    } else {
+      robot.setAttribute('points', '');
+    }
+  } catch (_) { /* the state poll reports a lost server */ }
+}
+setInterval(pollMap, 500);
+
+// ---- capture: a box dragged on the camera image, in the frame's own pixels -----------------
+let box = null;  // [x, y, w, h] in image pixels
+let dragFrom = null;  // frames are not swapped while a box is being dragged
+// The last loaded frame's size: naturalWidth reads 0 while the next frame loads.
+let frameSize = [0, 0];
+const overlay = $('camera-overlay');
+function sizeOverlay() {
+  const img = $('camera-img');
+  const wrap = $('camera-wrap').getBoundingClientRect(), r = img.getBoundingClientRect();
+  Object.assign(overlay.style, { left: `${r.left - wrap.left}px`, top: `${r.top - wrap.top}px`, width: `${r.width}px`, height: `${r.height}px` });
+  if (overlay.width !== Math.round(r.width) || overlay.height !== Math.round(r.height)) {
+    overlay.width = Math.round(r.width);
+    overlay.height = Math.round(r.height);
+  }
+  drawBox();
+}
+window.addEventListener('resize', sizeOverlay);
+// Keep the overlay on the image whatever moves it (frames of another size, panel reflow).
+new ResizeObserver(sizeOverlay).observe($('camera-img'));
+function toImage(e) {
+  const r = $('camera-img').getBoundingClientRect(), [w, h] = frameSize;
+  const sx = w / r.width, sy = h / r.height;
+  return [Math.max(0, Math.min(w, (e.clientX - r.left) * sx)), Math.max(0, Math.min(h, (e.clientY - r.top) * sy))];
+}
+function drawBox() {
+  const ctx = overlay.getContext('2d');
+  ctx.clearRect(0, 0, overlay.width, overlay.height);
+  if (!box || !frameSize[0]) return;
+  const kx = overlay.width / frameSize[0], ky = overlay.height / frameSize[1];
+  ctx.strokeStyle = '#ff3df2';
+  ctx.lineWidth = 2;
+  ctx.setLineDash([6, 4]);
+  ctx.strokeRect(box[0] * kx, box[1] * ky, box[2] * kx, box[3] * ky);
+}
+overlay.addEventListener('pointerdown', (e) => {
+  if (!frameSize[0]) return;
+  sizeOverlay();
+  overlay.setPointerCapture(e.pointerId);
+  dragFrom = toImage(e);
+  box = null;
+  drawBox();
+});
+overlay.addEventListener('pointermove', (e) => {
+  if (!dragFrom) return;
+  const p = toImage(e);
+  box = [Math.min(p[0], dragFrom[0]), Math.min(p[1], dragFrom[1]), Math.abs(p[0] - dragFrom[0]), Math.abs(p[1] - dragFrom[1])].map(Math.round);
+  drawBox();
+});
+overlay.addEventListener('pointerup', () => {
+  dragFrom = null;
+  if (box && (box[2] < 16 || box[3] < 16)) box = null;  // a click clears the box
+  drawBox();
+  $('capture-box').disabled = !box;
+});
+
+async function capture(withBox) {
+  const cls = $('capture-class').value.trim();
+  if (!cls) { message($('capture-message'), 'Type a class name first.', 'error'); $('capture-class').focus(); return; }
+  try {
+    const r = await api('POST', '/api/capture', withBox ? { class: cls, box } : { class: cls });
+    message($('capture-message'), `Saved ${r.file.replace(/^.*\/([^/]+\/[^/]+)$/, '$1')} (${r.width}×${r.height})${r.new_class ? ' — new class' : ''}. Retrained on the next run.`, 'ok');
+    if (r.new_class) $('class-list').append(new Option(r.class));
+  } catch (e) {
+    message($('capture-message'), e.message, 'error');
+  }
+}
+$('capture-frame').addEventListener('click', () => capture(false));
+$('capture-box').addEventListener('click', () => capture(true));
+
+loadChoices();
+poll(true);
+pollMap();

@@ -1,0 +1,382 @@
+// HTTP tests of the live run page's API (`sketchnav ui`, run_api.h): start/state/frame/map,
+// Stop reaching the base, captures into the landmark set, and the guards refusing
+// cross-origin control requests. The run is a scripted runner that drives the hooks the way
+// `sketchnav run`'s harness does, so these tests stay fast and need no simulator.
+// Eigen-using headers first (run_api.h orders its own includes).
+#include "run_api.h"
+// clang-format off
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+
+#include "server.h"
+#include "test_data.h"
+// clang-format on
+
+using namespace sketchnav;
+namespace fs = std::filesystem;
+
+namespace {
+
+// Devices of the scripted run.
+struct FakeBaseLog {
+  std::atomic<int> commands{0}, stops{0};
+  std::atomic<bool> moving{false};
+  std::atomic<bool> stopped_from_other_thread{false};
+  std::thread::id run_thread;
+};
+
+class FakeBase final : public hw::Base {
+ public:
+  explicit FakeBase(std::shared_ptr<FakeBaseLog> log) : log_(std::move(log)) {}
+  void command(double v, double w) override {
+    log_->commands++;
+    log_->moving = v != 0 || w != 0;
+  }
+  void stop() noexcept override {
+    log_->stops++;
+    log_->moving = false;
+    if (std::this_thread::get_id() != log_->run_thread) log_->stopped_from_other_thread = true;
+  }
+  bool odometry(hw::Odometry& out) override { return true; }
+  bool ok() const override { return true; }
+  hw::DeviceStats stats() const override { return {}; }
+  std::string uri() const override { return "fake://base"; }
+
+ private:
+  std::shared_ptr<FakeBaseLog> log_;
+};
+
+class FakeCamera final : public hw::Camera {
+ public:
+  hw::GrabStatus grab(hw::Frame& f, double) override {
+    f.image = cv::Mat(240, 320, CV_8UC3, cv::Scalar(60, 90, 120));
+    cv::rectangle(f.image, {100, 60, 80, 100}, {20, 200, 240}, cv::FILLED);
+    f.seq = ++seq_;
+    f.stamp = seq_ * 0.1;
+    return hw::GrabStatus::Ok;
+  }
+  hw::Intrinsics intrinsics() const override { return hw::Intrinsics::fromFov(320, 240, 1.0); }
+  hw::DeviceStats stats() const override {
+    hw::DeviceStats s;
+    s.received = seq_;
+    return s;
+  }
+  std::string uri() const override { return "fake://camera"; }
+
+ private:
+  std::uint64_t seq_ = 0;
+};
+
+// Ticks every 10 ms (wall time) for at most `max_ticks`, moving forward, in 3 sections; ends
+// like the executive: "stopped by user" when asked, else "arrived".
+ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000) {
+  return [log, max_ticks](const ui::RunRequest& rq, const ui::RunHooks& h) -> Json {
+    log->run_thread = std::this_thread::get_id();
+    if (rq.world == "missing") throw InputError("--world missing: no such world");
+    h.on_map({{"frame", "odometry"}, {"sketch_path", {{0, 0}, {3, 0}, {3, 2}}}});
+    auto camera = h.wrap_camera(std::make_unique<FakeCamera>());
+    auto base = h.wrap_base(std::make_unique<FakeBase>(log));
+    h.on_event({{"type", "start"}, {"t", 0.0}, {"sections", 3}, {"route_length_m", 5.0}});
+    std::string reason = "arrived";
+    bool success = true;
+    for (int i = 0; i < max_ticks; ++i) {
+      if (h.stop_requested()) {
+        base->stop();
+        reason = "stopped by user";
+        success = false;
+        h.on_event({{"type", "failed"}, {"t", i * 0.05}, {"reason", reason}});
+        break;
+      }
+      hw::Frame f;
+      camera->grab(f, 1.0);
+      if (i % 4 == 0) {
+        nav::Observation o;
+        nav::Detection d;
+        d.class_name = "Oatly-Oat-Milk";
+        d.window = {100, 60, 80, 100};
+        d.inliers = 33;
+        o.detections.push_back(d);
+        o.timing.windows = 30;
+        h.on_observation(f, o);
+      }
+      base->command(0.3, 0.1);
+      nav::TelemetryRow r;
+      r.t = i * 0.05;
+      r.odom.x = i * 0.015;
+      r.v_cmd = 0.3;
+      r.w_cmd = 0.1;
+      r.mode = "follow";
+      r.turn = "Straight";
+      r.section = std::min(2, i / 20);
+      h.on_tick(r);
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return {{"success", success}, {"reason", reason}};
+  };
+}
+
+class UiRunHttp : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    dir_ = test::tempDir("uirunhttp");
+    log_ = std::make_shared<FakeBaseLog>();
+    ui::RunApiOptions ro;
+    ro.runner = scriptedRunner(log_);
+    ro.capture_dir = dir_ + "/landmarks";
+    ro.worlds = {"corridor", "lab"};
+    ro.propose_windows = [this](const cv::Mat& img) {
+      windows_calls_++;
+      return std::vector<cv::Rect>{{10, 10, 50, 50}};
+    };
+    rc_ = std::make_unique<ui::RunController>(ro);
+    ui::ServerOptions so;
+    so.port = 0;
+    server_ = std::make_unique<ui::Server>(so);
+    ui::addRunRoutes(*server_, *rc_);
+    port_ = server_->bind();
+    thread_ = std::thread([this] { server_->serve(); });
+    cli_ = std::make_unique<httplib::Client>("127.0.0.1", port_);
+    cli_->set_connection_timeout(5);
+    cli_->set_read_timeout(10);
+  }
+  void TearDown() override {
+    server_->stop();
+    thread_.join();
+    rc_.reset();  // stops and joins a run still going
+  }
+  static Json body(const httplib::Result& r) { return Json::parse(r->body); }
+  httplib::Result post(const std::string& path, const Json& j, const httplib::Headers& extra = {}) {
+    return cli_->Post(path.c_str(), extra, j.dump(), "application/json");
+  }
+  // Polls the state until `pred` holds (bounded; no timing is asserted).
+  Json waitFor(const std::function<bool(const Json&)>& pred) {
+    Json s;
+    for (int i = 0; i < 500; ++i) {
+      auto r = cli_->Get("/api/run/state");
+      s = body(r);
+      if (pred(s)) return s;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    ADD_FAILURE() << "state never reached: " << s.dump();
+    return s;
+  }
+
+  std::string dir_;
+  std::shared_ptr<FakeBaseLog> log_;
+  std::atomic<int> windows_calls_{0};
+  std::unique_ptr<ui::RunController> rc_;
+  std::unique_ptr<ui::Server> server_;
+  std::thread thread_;
+  int port_ = 0;
+  std::unique_ptr<httplib::Client> cli_;
+};
+
+TEST_F(UiRunHttp, IdleStateHasNoFrame) {
+  auto s = body(cli_->Get("/api/run/state"));
+  EXPECT_EQ(s["status"], "idle");
+  EXPECT_FALSE(s["active"].get<bool>());
+  auto f = cli_->Get("/api/run/frame.jpg");
+  ASSERT_TRUE(f);
+  EXPECT_EQ(f->status, 404);
+  EXPECT_EQ(body(cli_->Get("/api/run/worlds"))["worlds"], Json({"corridor", "lab"}));
+  // Stop with nothing running is harmless.
+  auto r = post("/api/run/stop", Json::object());
+  EXPECT_EQ(r->status, 200);
+  EXPECT_FALSE(body(r)["stopped"].get<bool>());
+}
+
+TEST_F(UiRunHttp, StartShowsProgressAndStopStopsTheBase) {
+  auto r = post("/api/run/start", {{"world", "corridor"}, {"seed", 3}});
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  // A second start while running is refused.
+  auto again = post("/api/run/start", {{"world", "corridor"}});
+  EXPECT_EQ(again->status, 400);
+  EXPECT_NE(body(again)["error"].get<std::string>().find("already"), std::string::npos);
+
+  Json s = waitFor([](const Json& s) { return s["section"].get<int>() >= 2; });
+  EXPECT_EQ(s["status"], "running");
+  EXPECT_EQ(s["sections"], 3);
+  EXPECT_EQ(s["turn"], "Straight");
+  EXPECT_DOUBLE_EQ(s["v"].get<double>(), 0.3);
+  EXPECT_GT(s["pose"]["x"].get<double>(), 0.2);
+  EXPECT_EQ(s["request"]["world"], "corridor");
+  EXPECT_EQ(s["request"]["seed"], 3);
+  EXPECT_TRUE(s["health"]["camera"]["ok"].get<bool>());
+  EXPECT_TRUE(s["health"]["base"]["ok"].get<bool>());
+  EXPECT_EQ(s["base"]["last"], "command");
+  EXPECT_EQ(s["perception"]["windows"], 30);
+
+  auto f = cli_->Get("/api/run/frame.jpg");
+  ASSERT_EQ(f->status, 200);
+  EXPECT_EQ(f->get_header_value("Content-Type"), "image/jpeg");
+  const cv::Mat img =
+      cv::imdecode(std::vector<unsigned char>(f->body.begin(), f->body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(img.cols, 320);
+  // The detection's window is drawn in green on its edge (the frame there was yellow-ish).
+  const cv::Vec3b edge = img.at<cv::Vec3b>(120, 100);
+  EXPECT_GT(edge[1], 150);
+  EXPECT_LT(edge[2], 120);
+  // The objectness windows of that frame, thin and blue-ish, computed once per frame shown.
+  const cv::Vec3b win = img.at<cv::Vec3b>(35, 10);
+  EXPECT_GT(win[0], win[2] + 40);
+  EXPECT_EQ(windows_calls_.load(), 1);
+  EXPECT_EQ(s["perception"]["detections"], 1);
+
+  auto m = body(cli_->Get("/api/run/map"));
+  EXPECT_EQ(m["geometry"]["frame"], "odometry");
+  EXPECT_GE(m["trajectory"].size(), 3u);
+  EXPECT_TRUE(m["pose"].is_object());
+
+  EXPECT_TRUE(log_->moving.load());
+  auto st = post("/api/run/stop", Json::object());
+  ASSERT_EQ(st->status, 200);
+  EXPECT_TRUE(body(st)["stopped"].get<bool>());
+  s = waitFor([](const Json& s) { return !s["active"].get<bool>(); });
+  EXPECT_EQ(s["status"], "stopped");
+  EXPECT_EQ(s["reason"], "stopped by user");
+  EXPECT_EQ(s["base"]["v"], 0.0);
+  EXPECT_EQ(s["v"], 0.0);
+  EXPECT_EQ(s["mode"], "stopped");
+  EXPECT_EQ(s["base"]["last"], "stop");
+  EXPECT_GE(s["base"]["stops"].get<int>(), 1);
+  EXPECT_FALSE(log_->moving.load());
+  EXPECT_GE(log_->stops.load(), 1);
+  // The simulator is only ever touched by the run thread.
+  EXPECT_FALSE(log_->stopped_from_other_thread.load());
+  bool stop_event = false;
+  for (const auto& e : s["events"])
+    if (e.value("reason", "") == "stopped by user") stop_event = true;
+  EXPECT_TRUE(stop_event) << s["events"].dump();
+
+  // A new run can start after the previous one ended.
+  EXPECT_EQ(post("/api/run/start", {{"world", "lab"}})->status, 200);
+  waitFor([](const Json& s) { return s["status"] == "running"; });
+  post("/api/run/stop", Json::object());
+  waitFor([](const Json& s) { return s["status"] == "stopped"; });
+}
+
+TEST_F(UiRunHttp, StopOnARealRobotStopsTheBaseFromTheRequest) {
+  ASSERT_EQ(post("/api/run/start", {{"robot", "dani://10.0.0.2"}, {"camera", "aravis://"}})->status,
+            200);
+  waitFor([](const Json& s) { return s["base"]["last"] == "command"; });
+  post("/api/run/stop", Json::object());
+  // Stopped by the request itself, not only at the run's next tick.
+  EXPECT_TRUE(log_->stopped_from_other_thread.load());
+  EXPECT_FALSE(log_->moving.load());
+  const Json s = waitFor([](const Json& s) { return s["status"] == "stopped"; });
+  EXPECT_EQ(s["request"]["mode"], "hardware");
+}
+
+TEST_F(UiRunHttp, RunnerErrorsAreShown) {
+  ASSERT_EQ(post("/api/run/start", {{"world", "missing"}})->status, 200);
+  const Json s = waitFor([](const Json& s) { return !s["active"].get<bool>(); });
+  EXPECT_EQ(s["status"], "error");
+  EXPECT_NE(s["reason"].get<std::string>().find("no such world"), std::string::npos);
+}
+
+TEST_F(UiRunHttp, BadStartRequestsAreRefused) {
+  EXPECT_EQ(post("/api/run/start", {{"world", "corridor"}, {"seed", -1}})->status, 400);
+  EXPECT_EQ(post("/api/run/start", {{"world", 5}})->status, 400);
+  EXPECT_EQ(post("/api/run/start", {{"camera", "aravis://"}})->status, 400);  // no robot
+  EXPECT_EQ(post("/api/run/start", {{"max_time_s", "long"}})->status, 400);
+  EXPECT_EQ(post("/api/run/start", {{"camera_only", true}})->status, 400);  // which camera?
+  EXPECT_EQ(post("/api/run/start", {{"camera_only", "yes"}, {"camera", "video://0"}})->status, 400);
+  auto r = cli_->Post("/api/run/start", "{not json", "application/json");
+  EXPECT_EQ(r->status, 400);
+  EXPECT_EQ(body(cli_->Get("/api/run/state"))["status"], "idle");
+}
+
+TEST_F(UiRunHttp, ControlEndpointsRefuseCrossOriginRequests) {
+  const httplib::Headers evil = {{"Origin", "http://evil.example"}};
+  const httplib::Headers cross = {{"Sec-Fetch-Site", "cross-site"}};
+  const httplib::Headers rebind = {{"Host", "evil.example:" + std::to_string(port_)}};
+  for (const auto& h : {evil, cross, rebind}) {
+    EXPECT_EQ(post("/api/run/start", {{"world", "corridor"}}, h)->status, 403);
+    EXPECT_EQ(post("/api/run/stop", Json::object(), h)->status, 403);
+    EXPECT_EQ(post("/api/capture", {{"class", "X"}}, h)->status, 403);
+    EXPECT_EQ(cli_->Get("/api/run/frame.jpg", h)->status, 403);  // the camera is private too
+  }
+  EXPECT_EQ(body(cli_->Get("/api/run/state"))["status"], "idle");
+  // The page's own origin is fine.
+  const httplib::Headers own = {{"Origin", "http://127.0.0.1:" + std::to_string(port_)}};
+  EXPECT_EQ(post("/api/run/start", {{"world", "corridor"}}, own)->status, 200);
+  // A cross-origin Stop is refused as well, and the run goes on until the page stops it.
+  EXPECT_EQ(post("/api/run/stop", Json::object(), evil)->status, 403);
+  EXPECT_TRUE(body(cli_->Get("/api/run/state"))["active"].get<bool>());
+  EXPECT_EQ(post("/api/run/stop", Json::object(), own)->status, 200);
+}
+
+TEST_F(UiRunHttp, CaptureSavesFramesAndCropsIntoClassFolders) {
+  // No camera yet.
+  auto r = post("/api/capture", {{"class", "Mug"}});
+  EXPECT_EQ(r->status, 400);
+  ASSERT_EQ(post("/api/run/start", {{"world", "corridor"}})->status, 200);
+  waitFor([](const Json& s) { return s["frame_seq"].get<int>() > 0; });
+
+  r = post("/api/capture", {{"class", "Red Mug"}});
+  ASSERT_EQ(r->status, 200) << r->body;
+  Json j = body(r);
+  EXPECT_EQ(j["class"], "Red Mug");
+  EXPECT_TRUE(j["new_class"].get<bool>());
+  const fs::path first = dir_ + "/landmarks/Red Mug/capture_1.jpg";
+  ASSERT_TRUE(fs::exists(first));
+  EXPECT_EQ(cv::imread(first.string()).cols, 320);
+
+  r = post("/api/capture", {{"class", "Red Mug"}, {"box", {100.4, 60, 80, 100}}});
+  ASSERT_EQ(r->status, 200) << r->body;
+  const cv::Mat crop = cv::imread(dir_ + "/landmarks/Red Mug/capture_2.jpg");
+  ASSERT_FALSE(crop.empty());
+  EXPECT_EQ(crop.cols, 80);
+  EXPECT_EQ(crop.rows, 100);
+  // The crop is of the raw frame (no drawn boxes): the yellow-ish patch.
+  const cv::Vec3b c = crop.at<cv::Vec3b>(50, 40);
+  EXPECT_GT(c[2], 200);
+  EXPECT_FALSE(body(r)["new_class"].get<bool>());
+  // A box partly outside the frame is clipped to it.
+  r = post("/api/capture", {{"class", "Red Mug"}, {"box", {310, 200, 100, 100}}});
+  EXPECT_EQ(r->status, 400);  // 10x40 left: too small
+  r = post("/api/capture", {{"class", "Red Mug"}, {"box", {280, 180, 100, 100}}});
+  ASSERT_EQ(r->status, 200);
+  EXPECT_EQ(body(r)["width"], 40);
+
+  for (const std::string bad : {"../evil", "a/b", "", ".hidden", "..", "a\\b", "x\n"}) {
+    auto b = post("/api/capture", {{"class", bad}});
+    EXPECT_EQ(b->status, 400) << bad;
+  }
+  EXPECT_EQ(post("/api/capture", {{"class", "Mug"}, {"box", {1, 2, 3}}})->status, 400);
+  EXPECT_EQ(post("/api/capture", Json::object())->status, 400);
+  EXPECT_FALSE(fs::exists(dir_ + "/evil"));
+  int files = 0;
+  for (const auto& e : fs::recursive_directory_iterator(dir_ + "/landmarks"))
+    files += e.is_regular_file();
+  EXPECT_EQ(files, 3);
+  post("/api/run/stop", Json::object());
+}
+
+TEST(RunRequest, CameraOnlyNeedsOnlyACamera) {
+  const auto r = ui::RunRequest::fromJson({{"camera_only", true}, {"camera", "video://0"}});
+  EXPECT_TRUE(r.camera_only);
+  EXPECT_EQ(r.toJson()["mode"], "camera");
+  EXPECT_EQ(r.toJson()["camera"], "video://0");
+  const auto sim = ui::RunRequest::fromJson({{"world", "lab"}, {"max_time_s", 30}});
+  EXPECT_FALSE(sim.hardware());
+  EXPECT_EQ(sim.toJson()["mode"], "sim");
+  EXPECT_DOUBLE_EQ(sim.max_time_s, 30);
+}
+
+TEST(SafeClassName, AcceptsFolderNamesOfTheLandmarkSet) {
+  EXPECT_EQ(ui::safeClassName("Oatly-Oat-Milk"), "Oatly-Oat-Milk");
+  EXPECT_EQ(ui::safeClassName("Red Mug 2"), "Red Mug 2");
+  EXPECT_THROW(ui::safeClassName(std::string(81, 'a')), InputError);
+  EXPECT_THROW(ui::safeClassName("mug."), InputError);
+}
+
+}  // namespace
