@@ -12,7 +12,8 @@ namespace {
 int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("run", "navigate: the simulated lab by default, or a real robot via device URIs",
             "[--world NAME|FILE] [--sketch FILE] [--model FILE] [--seed N] [--realtime] "
-            "[--out DIR] [--robot URI --camera URI --laser URI --sonar URI]");
+            "[--out DIR] [--robot URI --camera URI --laser URI --sonar URI] [--record FILE] "
+            "[--replay FILE]");
   args.option("world", "simulated world: a name in share/worlds or a .world.json file", "lab")
       .option("sketch", "the hand-drawn map (.sketch.json); default: the world's sketch")
       .option("model",
@@ -27,7 +28,9 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("robot", "base URI for a real robot, e.g. dani://192.168.1.20:5000")
       .option("camera", "camera URI, e.g. aravis://192.168.1.10 or video://0")
       .option("laser", "laser URI")
-      .option("sonar", "sonar URI");
+      .option("sonar", "sonar URI")
+      .option("record", "also write frames, odometry, scans and commands to this MRPT rawlog")
+      .option("replay", "run simulator-free on a recorded rawlog (from --record)");
   if (!args.parse(argv)) return 0;
   RunOptions o;
   o.world = args.get("world");
@@ -42,6 +45,8 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   o.camera = args.get("camera");
   o.laser = args.get("laser");
   o.sonar = args.get("sonar");
+  o.record = args.get("record");
+  o.replay = args.get("replay");
   o.config = g.config;
   o.out_dir = makeOutputDir(args.get("out"));
   o.progress = true;

@@ -15,6 +15,8 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/hw/rawlog.h"
+#include "sketchnav/hw/recording.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/mapsketch/io.h"
@@ -229,8 +231,12 @@ Json runNavigation(const RunOptions& o) {
   using wall = std::chrono::steady_clock;
   hw::registerBuiltinDrivers();
   sim::registerDrivers();
-  const bool hardware =
-      !o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty();
+  const bool replay = !o.replay.empty();
+  if (replay && (!o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty()))
+    throw InputError("--replay cannot be combined with --robot/--camera/--laser/--sonar");
+  // A replayed rawlog is treated like hardware (no simulator, no world map, odometry only).
+  const bool hardware = replay || !o.robot.empty() || !o.camera.empty() || !o.laser.empty() ||
+                        !o.sonar.empty();
   if (o.seed < 0) throw InputError("--seed must be >= 0");
   hw::DeviceContext ctx;
   ctx.config = o.config;
@@ -258,6 +264,23 @@ Json runNavigation(const RunOptions& o) {
       laser = hw::Registry::instance().createRange(world_uri + q + "&sensor=laser", ctx);
     if (simr->world().sonar.enabled)
       sonar = hw::Registry::instance().createRange(world_uri + q + "&sensor=sonar", ctx);
+  } else if (replay) {
+    if (!fs::exists(o.replay)) throw InputError("--replay " + o.replay + ": no such file");
+    const std::string uri = "rawlog://" + fs::absolute(o.replay).string();
+    // Simulated time: the log is replayed at its recorded pace on a clock that jumps, so the
+    // replay runs as fast as the CPU allows and every device stays in step.
+    ctx.clock = std::make_shared<hw::SimClock>();
+    base = hw::Registry::instance().createBase(uri, ctx);
+    camera = hw::Registry::instance().createCamera(uri + "?realtime=1", ctx);
+    // A log may hold no laser or no sonar scans: that device is then simply absent.
+    try {
+      laser = hw::Registry::instance().createRange(uri, ctx);
+    } catch (const InputError&) {
+    }
+    try {
+      sonar = hw::Registry::instance().createRange(uri + "?label=SONAR", ctx);
+    } catch (const InputError&) {
+    }
   } else {
     if (o.robot.empty()) throw InputError("--robot URI is required with hardware devices");
     ctx.clock = std::make_shared<hw::SteadyClock>();
@@ -269,6 +292,13 @@ Json runNavigation(const RunOptions& o) {
   if (o.wrap_camera && camera) camera = o.wrap_camera(std::move(camera));
   if (o.wrap_base && base) base = o.wrap_base(std::move(base));
   if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
+  if (!o.record.empty()) {
+    auto rec = std::make_shared<hw::RawlogRecorder>(o.record);
+    camera = hw::recordCamera(std::move(camera), rec);
+    base = hw::recordBase(std::move(base), rec, ctx.clock);
+    if (laser) laser = hw::recordRange(std::move(laser), rec, "LASER");
+    if (sonar) sonar = hw::recordRange(std::move(sonar), rec, "SONAR");
+  }
 
   // --- sketch -> route ----------------------------------------------------------------------
   std::string sketch_path = o.sketch;
@@ -374,7 +404,8 @@ Json runNavigation(const RunOptions& o) {
   Json s;
   bool success = es.status == nav::RunStatus::Succeeded;
   std::string reason = es.reason;
-  s["mode"] = hardware ? "hardware" : "sim";
+  s["mode"] = replay ? "replay" : hardware ? "hardware" : "sim";
+  if (!o.record.empty()) s["record"] = o.record;
   s["time_s"] = es.time_s;
   s["wall_time_s"] = wall_s;
   s["real_time_factor"] = wall_s > 0 ? es.time_s / wall_s : 0.0;

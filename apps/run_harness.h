@@ -26,6 +26,9 @@ struct RunOptions {
   std::string out_dir;    // "" = write no files
   // Hardware: any of these set -> a real robot (each empty one is absent).
   std::string robot, camera, laser, sonar;
+  std::string record;  // non-empty: append every frame, odometry, scan and command to this
+                       // MRPT rawlog (images beside it), flushed per record
+  std::string replay;  // non-empty: run simulator-free on a recorded rawlog's devices
   Config config;         // --config / --set (nav.*, servo.*, sim.*, ...)
   bool progress = true;  // progress lines on stderr
   /// Wraps the camera (tests: drop it mid-run; `sketchnav ui`: show and capture its frames).

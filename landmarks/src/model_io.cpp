@@ -11,10 +11,13 @@
 #include <opencv2/flann/random.h>
 
 #include <cstring>
+#include <filesystem>
 #include <fstream>
 #include <iterator>
 #include <limits>
 #include <mutex>
+
+#include <unistd.h>
 
 #include "model_internal.h"
 #include "sketchnav/core/error.h"
@@ -208,7 +211,10 @@ void LandmarkModel::save(const std::string& path) const {
     w.mat(cv::Mat(ph.words, true).reshape(1, 1));
   }
   const std::string& payload = w.buffer();
-  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  // Written beside the target and renamed into place, so a reader (another process sharing the
+  // model cache, or a crash mid-write) never sees a half-written model.
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw RuntimeError(path + ": cannot write landmark model");
   const std::uint32_t version = kFormatVersion;
   const std::uint64_t size = payload.size(), sum = detail::fnv1a(payload.data(), payload.size());
@@ -218,7 +224,16 @@ void LandmarkModel::save(const std::string& path) const {
   out.write(reinterpret_cast<const char*>(&sum), sizeof sum);
   out.write(payload.data(), static_cast<std::streamsize>(payload.size()));
   out.close();
-  if (!out) throw RuntimeError(path + ": writing the landmark model failed (disk full?)");
+  std::error_code ec;
+  if (!out) {
+    std::filesystem::remove(tmp, ec);
+    throw RuntimeError(path + ": writing the landmark model failed (disk full?)");
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    std::filesystem::remove(tmp, ec);
+    throw RuntimeError(path + ": cannot move the landmark model into place: " + ec.message());
+  }
 }
 
 LandmarkModel LandmarkModel::load(const std::string& path) {

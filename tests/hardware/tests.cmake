@@ -20,3 +20,13 @@ if(SKETCHNAV_BUILD_TESTS)
   gtest_discover_tests(test_hw_loopback DISCOVERY_TIMEOUT 60
     PROPERTIES TIMEOUT 120 LABELS hardware RESOURCE_LOCK gvcp_3956)
 endif()
+
+# `run --record FILE` then `run --replay FILE`: a short simulated run on the integration hall
+# leaves a readable rawlog (frames, odometry, scans, commands), which the simulator-free replay
+# reads back.
+add_test(NAME run_record_replay
+  COMMAND ${CMAKE_COMMAND} -DSN=$<TARGET_FILE:sketchnav> -DSRC=${PROJECT_SOURCE_DIR}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/record-replay
+          -DCACHE=${PROJECT_BINARY_DIR}/model-cache
+          -P ${CMAKE_CURRENT_LIST_DIR}/record_replay.cmake)
+set_tests_properties(run_record_replay PROPERTIES TIMEOUT 300 LABELS "hardware;integration")
