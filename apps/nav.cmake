@@ -3,7 +3,8 @@
 # integration tests (tests/integration) run exactly what the command runs.
 add_library(sketchnav_runharness STATIC run_harness.cpp)
 target_include_directories(sketchnav_runharness PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
-target_link_libraries(sketchnav_runharness PUBLIC sketchnav::core sketchnav::hw
-  PRIVATE sketchnav::sim sketchnav::mapsketch sketchnav::landmarks sketchnav::nav opencv_imgproc)
+# nav is public: RunOptions' observer hooks carry nav types (TelemetryRow, Observation).
+target_link_libraries(sketchnav_runharness PUBLIC sketchnav::core sketchnav::hw sketchnav::nav
+  PRIVATE sketchnav::sim sketchnav::mapsketch sketchnav::landmarks opencv_imgproc)
 target_compile_options(sketchnav_runharness PRIVATE -Wall -Wextra -Wno-unused-parameter)
 target_link_libraries(sketchnav PRIVATE sketchnav_runharness)

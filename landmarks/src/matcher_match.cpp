@@ -29,6 +29,16 @@ FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bg
   return f;
 }
 
+FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr,
+                                   FeatureParams frame_params) {
+  frame_params.root_sift = model.params().features.root_sift;  // must match the database
+  frame_params.validate();
+  FrameFeatures f;
+  f.features = extractFeatures(bgr, frame_params);
+  f.words = model.vocabulary().assign(f.features.descriptors);
+  return f;
+}
+
 namespace detail {
 
 std::vector<int> keypointsInWindow(const FrameFeatures& frame, const cv::Rect& window) {

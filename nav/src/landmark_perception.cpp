@@ -19,6 +19,8 @@ void PerceptionParams::validate() const {
   require(ratio > 0 && ratio < 1, "nav.perception.ratio", "must be in (0, 1)");
   require(max_photos >= 1, "nav.perception.max_photos", "must be >= 1");
   require(merge_iou > 0 && merge_iou <= 1, "nav.perception.merge_iou", "must be in (0, 1]");
+  require(frame_max_side >= 64, "nav.perception.frame_max_side", "must be >= 64 px");
+  require(frame_max_features >= 0, "nav.perception.frame_max_features", "must be >= 0");
 }
 
 struct LandmarkPerception::Impl {
@@ -62,7 +64,10 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
   ob.timing.windows = static_cast<int>(windows.size());
 
   t = clk::now();
-  const auto feats = landmarks::computeFrameFeatures(model, frame.image);
+  landmarks::FeatureParams fp = model.params().features;
+  fp.max_image_side = P.frame_max_side;
+  fp.max_features = P.frame_max_features;
+  const auto feats = landmarks::computeFrameFeatures(model, frame.image, fp);
   ob.timing.features_ms = msSince(t);
 
   t = clk::now();

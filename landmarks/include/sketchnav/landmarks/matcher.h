@@ -47,6 +47,12 @@ struct FrameFeatures {
   std::vector<int> words;  // visual word per keypoint
 };
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr);
+/// Same with explicit feature settings for the frame (e.g. a camera frame kept at full
+/// resolution with more keypoints, where a small landmark would vanish at the model's
+/// photo-sized settings). Descriptors stay comparable: SIFT is scale invariant and the
+/// descriptor kind (RootSIFT or SIFT) is forced to the model's.
+FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr,
+                                   FeatureParams frame_params);
 
 struct MatchResult {
   bool matched = false;
