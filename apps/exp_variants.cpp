@@ -158,7 +158,7 @@ Variant makeVariant(const std::string& name) {
     v.description = "four landmarks, evenly spread (L1, L3, L5, L7)";
     keepLandmarks(w, {"L1", "L3", "L5", "L7"});
   } else if (name == "exp3-4-uneven") {
-    v.description = "four landmarks, all in room A (L1-L4): room B on odometry alone";
+    v.description = "four landmarks, all before room B (L1-L4): room B on odometry alone";
     keepLandmarks(w, {"L1", "L2", "L3", "L4"});
   } else if (name == "exp4-repeated-a") {
     v.description = "eight landmarks, L2, L5, L8 all Arla-Standard-Milk (spread out)";

@@ -56,8 +56,8 @@ TEST(ExperimentVariants, TransformationsAsDocumented) {
   EXPECT_EQ(landmarkCount(makeVariant("exp3-4")), 4);
   const Variant uneven = makeVariant("exp3-4-uneven");
   ASSERT_EQ(landmarkCount(uneven), 4);
-  for (const auto& l : uneven.world["landmarks"])  // all in room A (x < 8 m)
-    EXPECT_LT(l["position"][0].get<double>(), 8.0);
+  // None in room B (its wall with the walkway is at x = 10 m): room B on odometry alone.
+  for (const auto& l : uneven.world["landmarks"]) EXPECT_LT(l["position"][0].get<double>(), 10.0);
   for (const char* name : {"exp4-repeated-a", "exp4-repeated-b"}) {
     std::map<std::string, int> per_class;
     const Variant v = makeVariant(name);  // (not a temporary: the loop refers into it)
@@ -87,10 +87,13 @@ TEST(ExperimentVariants, SketchNoiseIsSeeded) {
   SketchNoise none;
   none.landmark_sigma_m = none.distance_sigma = none.distance_round_m = 0;
   none.path_sigma_m = none.jitter_px = 0;
-  // Without noise the distances are the true ones (L1 is 2.8 m from the start).
+  // Without noise the distances are the true ones: L1's from the world's start pose.
   const Json s = makeSketch(v, none, 1);
-  EXPECT_NEAR(s["landmarks"][0]["distance_m"].get<double>(), std::hypot(3.6 - 0.8, 9.6 - 10.1),
-              1e-9);
+  const Json& l1 = v.world["landmarks"][0];
+  ASSERT_EQ(l1["id"], "L1");
+  const double dx = l1["position"][0].get<double>() - v.world["start"]["x"].get<double>();
+  const double dy = l1["position"][1].get<double>() - v.world["start"]["y"].get<double>();
+  EXPECT_NEAR(s["landmarks"][0]["distance_m"].get<double>(), std::hypot(dx, dy), 1e-9);
   SketchNoise bad;
   bad.distance_sigma = -1;
   EXPECT_THROW(makeSketch(v, bad, 1), InputError);
