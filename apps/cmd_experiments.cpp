@@ -67,8 +67,8 @@ void drawVariantFigure(const std::string& path, const Variant& v,
     x += 34 + 12 +
          cv::getTextSize(legend[i].first, cv::FONT_HERSHEY_SIMPLEX, 0.42, 1, nullptr).width;
   }
-  cv::putText(fig, "stars: landmarks", {x, y},
-              cv::FONT_HERSHEY_SIMPLEX, 0.42, {90, 90, 90}, 1, cv::LINE_AA);
+  cv::putText(fig, "stars: landmarks", {x, y}, cv::FONT_HERSHEY_SIMPLEX, 0.42, {90, 90, 90}, 1,
+              cv::LINE_AA);
   if (!cv::imwrite(path, fig)) throw RuntimeError("cannot write " + path);
 }
 
@@ -106,25 +106,17 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       args.get("variants").empty() ? variantNames() : args.getList("variants");
   std::vector<Variant> variants;
   for (const auto& n : names) variants.push_back(makeVariant(n));  // InputError on unknown
-  SketchNoise noise;
-  applyConfig(noise, g.config, "experiments.sketch");
-  noise.validate();
+  const SketchNoise noise = sketchNoiseFrom(g.config);
 
   const std::string out = makeOutputDir(args.get("out"));
   const std::string model = ensureModel(args.get("model"), true);
-  std::string config_file;
-  if (!g.config.toJson().empty()) {
-    config_file = out + "/config.json";
-    std::ofstream(config_file) << g.config.toJson().dump(2) << "\n";
-  }
+  const std::string config_file = writeBatchConfig(g.config, out);
 
   std::vector<ScenarioSpec> specs;
   for (size_t vi = 0; vi < variants.size(); ++vi) {
     const Variant& v = variants[vi];
     const std::string vdir = out + "/" + v.name;
-    fs::create_directories(vdir);
-    const std::string wf = vdir + "/" + v.name + ".world.json";
-    std::ofstream(wf) << v.world.dump(1) << "\n";
+    const std::string wf = writeVariantWorld(v, vdir);
     for (int k = 0; k < trials; ++k) {
       ScenarioSpec s;
       s.seed = seed0 + k;
@@ -133,9 +125,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       s.out_dir = vdir + "/trial-" + std::to_string(k + 1);
       fs::create_directories(s.out_dir);
       s.sketch_file = s.out_dir + "/sketch.json";
-      // The sketch noise seed mixes in the variant so variants do not share drawing errors.
-      std::ofstream(s.sketch_file)
-          << makeSketch(v, noise, static_cast<std::uint64_t>(s.seed) * 101 + vi).dump(1) << "\n";
+      writeVariantSketch(v, noise, s.seed, vi, s.sketch_file);
       s.model = model;
       s.config_file = config_file;
       s.max_time_s = max_time;
@@ -163,7 +153,6 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
      << "| variant | trials | successes | success rate | mean time [s] | failures |\n"
      << "|---|---:|---:|---:|---:|---|\n";
   std::ostringstream figs;
-  std::printf("%s", "");
   std::ostringstream table;
   table << "variant                   trials  success  rate    mean time [s]\n";
   for (size_t vi = 0; vi < variants.size(); ++vi) {

@@ -219,29 +219,20 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
   }
   std::vector<Variant> scen;
   for (const auto& n : args.getList("scenarios")) scen.push_back(makeVariant(n));
-  SketchNoise noise;
-  applyConfig(noise, g.config, "experiments.sketch");
-  noise.validate();
+  const SketchNoise noise = sketchNoiseFrom(g.config);
   const std::string out = makeOutputDir(args.get("out"));
   const std::string model = ensureModel(args.get("model"), true);
-  std::string config_file;
-  if (!g.config.toJson().empty()) {
-    config_file = out + "/config.json";
-    std::ofstream(config_file) << g.config.toJson().dump(2) << "\n";
-  }
+  const std::string config_file = writeBatchConfig(g.config, out);
   std::vector<ScenarioSpec> specs;
   std::vector<size_t> value_of;
   for (size_t si = 0; si < scen.size(); ++si) {
     const auto& v = scen[si];
     const std::string sdir = out + "/" + v.name;
-    fs::create_directories(sdir);
-    const std::string wf = sdir + "/" + v.name + ".world.json";
-    std::ofstream(wf) << v.world.dump(1) << "\n";
+    const std::string wf = writeVariantWorld(v, sdir);
     for (int k = 0; k < seeds; ++k) {
       const int seed = seed0 + k;
       const std::string sk = sdir + "/sketch-" + std::to_string(seed) + ".json";
-      std::ofstream(sk) << makeSketch(v, noise, static_cast<std::uint64_t>(seed) * 101 + si).dump(1)
-                        << "\n";
+      writeVariantSketch(v, noise, seed, si, sk);
       for (size_t vi = 0; vi < values.size(); ++vi) {
         ScenarioSpec s;
         std::ostringstream val;

@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 #include <fstream>
 #include <map>
 #include <random>
@@ -255,6 +256,33 @@ Json makeSketch(const Variant& v, const SketchNoise& noise, std::uint64_t seed) 
           {"path", path},
           {"start", {start_px.x(), start_px.y()}},
           {"goal", {goal_px.x(), goal_px.y()}}};
+}
+
+SketchNoise sketchNoiseFrom(const Config& config) {
+  SketchNoise noise;
+  applyConfig(noise, config, "experiments.sketch");
+  return noise;
+}
+
+std::string writeVariantWorld(const Variant& v, const std::string& dir) {
+  std::filesystem::create_directories(dir);
+  const std::string path = dir + "/" + v.name + ".world.json";
+  std::ofstream(path) << v.world.dump(1) << "\n";
+  return path;
+}
+
+void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
+                        std::size_t variant_index, const std::string& path) {
+  const std::uint64_t noise_seed = static_cast<std::uint64_t>(seed) * 101 + variant_index;
+  std::ofstream(path) << makeSketch(v, noise, noise_seed).dump(1) << "\n";
+}
+
+std::string writeBatchConfig(const Config& config, const std::string& out) {
+  const Json j = config.toJson();
+  if (j.empty()) return "";
+  const std::string path = out + "/config.json";
+  std::ofstream(path) << j.dump(2) << "\n";
+  return path;
 }
 
 }  // namespace sketchnav::app

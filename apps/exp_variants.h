@@ -50,4 +50,21 @@ Variant makeVariant(const std::string& name);
 /// Canvas 1000 x 720 px, u = 32 + 52 x, v = 698 - 52 y (like share/sketches/lab.sketch.json).
 Json makeSketch(const Variant& v, const SketchNoise& noise, std::uint64_t seed);
 
+// --- batch set-up shared by `experiments` and `tune` ------------------------------------------
+
+/// The sketch noise from "experiments.sketch.*" settings over the defaults, validated.
+SketchNoise sketchNoiseFrom(const Config& config);
+
+/// Writes the variant's world to <dir>/<name>.world.json (dir created); returns the path.
+std::string writeVariantWorld(const Variant& v, const std::string& dir);
+
+/// Writes a sketch of `v` for simulator seed `seed` to `path`. `variant_index` is mixed into the
+/// noise seed so variants in one batch do not share drawing errors.
+void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
+                        std::size_t variant_index, const std::string& path);
+
+/// Writes the run's --config/--set settings to <out>/config.json for the child runs; returns
+/// its path, or "" when there are none.
+std::string writeBatchConfig(const Config& config, const std::string& out);
+
 }  // namespace sketchnav::app
