@@ -36,6 +36,7 @@ struct Runner {
   cv::Size frame_size;      // non-empty: letterbox every image into a frame of this size
   bool with_match = false;  // also run match() for the recognised class (servo cost)
   lm::MatchParams match_params;
+  lm::FeatureParams frame_features;  // SIFT settings for the images (model's frame_* by default)
 
   cv::Mat prepare(const cv::Mat& img) const {
     if (frame_size.area() == 0) return img;
@@ -58,7 +59,7 @@ struct Runner {
     std::vector<cv::Rect> boxes;
     if (objectness)
       for (const auto& w : objectness->propose(img, windows)) boxes.push_back(w.box);
-    const lm::FrameFeatures frame = lm::computeFrameFeatures(model, img);
+    const lm::FrameFeatures frame = lm::computeFrameFeatures(model, img, frame_features);
     auto out = lm::recognise(model, frame, boxes, top_k, params);
     if (with_match && !out.empty() && !out.front().rejected)
       lm::match(model, frame, out.front().window, out.front().class_name, match_params);
@@ -77,6 +78,8 @@ Json modeJson(const Runner& r) {
                                                std::to_string(r.frame_size.height))
                                         : Json("as is")},
           {"match", r.with_match},
+          {"frame_features", paramsToJson(r.frame_features)},
+          {"match_params", paramsToJson(r.match_params)},
           {"params", paramsToJson(r.params)}};
 }
 
@@ -201,7 +204,11 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
   model.buildIndexes();
   const double index_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tb).count();
-  Runner runner{model, {}, args.getInt("windows"), nullptr, {}, false, {}};
+  Runner runner{model, {}, args.getInt("windows"), nullptr, {}, false, {}, {}};
+  // Frame SIFT settings: the model's frame_* limits, overridable with landmarks.frame.* (e.g.
+  // bench/recognition/fast.json) without retraining.
+  runner.frame_features = model.params().frameFeatures();
+  applyConfig(runner.frame_features, g.config, "landmarks.frame");
   applyConfig(runner.params, g.config, "landmarks.recognition");
   if (args.flagSet("no-verify")) runner.params.verify = false;
   if (runner.windows < 0) throw InputError("sketchnav recognise: --windows must be >= 0");

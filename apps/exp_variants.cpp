@@ -135,15 +135,17 @@ Variant makeVariant(const std::string& name) {
   v.drawn_path = kBasePath;
   Json& w = v.world;
   if (name == "exp2-moved-a") {
-    v.description = "L1, L5, L7 slid 0.7-1.2 m along their furniture";
-    moveLandmark(w, "L1", 2.9, 9.6);
-    moveLandmark(w, "L5", 12.6, 8.25);
-    moveLandmark(w, "L7", 14.0, 5.0);
+    // Positions on the faces of the same furniture as in the lab world (a landmark inside a
+    // bench would be invisible, which is another experiment).
+    v.description = "L1, L5, L7 slid 0.9-1.0 m along their furniture";
+    moveLandmark(w, "L1", 3.7, 9.62, 120);  // humidifier table: left end -> top face
+    moveLandmark(w, "L5", 12.7, 7.56);      // test bench front face, 1 m to the right
+    moveLandmark(w, "L7", 14.6, 5.49);      // lab bench top face, 1 m to the left
   } else if (name == "exp2-moved-b") {
     v.description = "L2, L8 moved 0.4 m; L6 to the lab bench (other side of the path)";
-    moveLandmark(w, "L2", 5.2, 12.45);
-    moveLandmark(w, "L6", 13.8, 5.0, 90);
-    moveLandmark(w, "L8", 16.4, 0.6);
+    moveLandmark(w, "L2", 7.43, 10.5);      // cabinet A face, 0.4 m down
+    moveLandmark(w, "L6", 13.8, 5.35, 90);  // trash can -> lab bench top face
+    moveLandmark(w, "L8", 17.1, 0.6);       // cabinet B face, 0.4 m left
   } else if (name == "exp2-redrawn-c") {
     v.description = "guide line redrawn with fewer, straighter strokes (4 sections)";
     v.drawn_path = kRedrawnC;

@@ -46,7 +46,10 @@ std::string modelCachePath(const std::string& landmark_dir, const std::string& c
     h *= 1099511628211ull;
   }
   std::ostringstream name;
-  name << "landmarks-" << std::hex << std::setw(16) << std::setfill('0') << h << ".slm";
+  // The format version is in the name too: builds of different versions sharing one cache
+  // directory would otherwise keep retraining over each other's file.
+  name << "landmarks-v" << landmarks::LandmarkModel::kFormatVersion << "-" << std::hex
+       << std::setw(16) << std::setfill('0') << h << ".slm";
   return (fs::path(dir) / name.str()).string();
 }
 
@@ -235,8 +238,8 @@ Json runNavigation(const RunOptions& o) {
   if (replay && (!o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty()))
     throw InputError("--replay cannot be combined with --robot/--camera/--laser/--sonar");
   // A replayed rawlog is treated like hardware (no simulator, no world map, odometry only).
-  const bool hardware = replay || !o.robot.empty() || !o.camera.empty() || !o.laser.empty() ||
-                        !o.sonar.empty();
+  const bool hardware =
+      replay || !o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty();
   if (o.seed < 0) throw InputError("--seed must be >= 0");
   hw::DeviceContext ctx;
   ctx.config = o.config;
@@ -425,6 +428,8 @@ Json runNavigation(const RunOptions& o) {
   s["sections_done"] = es.sections_done;
   s["sections"] = es.sections;
   s["avoidance_manoeuvres"] = es.avoidance_manoeuvres;
+  s["recoveries"] = es.recoveries;
+  s["laser_odometry"] = ej["laser_odometry"];
   s["perception"] = {{"frames", es.frames},
                      {"frames_processed", es.frames_processed},
                      {"mean_ms", es.perception_ms_mean},
@@ -437,6 +442,8 @@ Json runNavigation(const RunOptions& o) {
                    {"servo", paramsToJson(settings.servo)},
                    {"avoid", paramsToJson(settings.avoid)},
                    {"safety", paramsToJson(settings.safety)},
+                   {"sections", paramsToJson(settings.sections)},
+                   {"laser_odometry", paramsToJson(settings.laser_odometry)},
                    {"perception", paramsToJson(pp)}};
   s["min_clearance_m"] = nullptr;
   s["deviation_m"] = nullptr;

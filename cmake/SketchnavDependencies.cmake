@@ -21,8 +21,8 @@ sketchnav_require(Eigen3_FOUND "Eigen 3" "libeigen3-dev")
 find_package(VISP QUIET COMPONENTS visp_core visp_vs visp_robot)
 sketchnav_require(VISP_FOUND "ViSP (visp_core, visp_vs, visp_robot)" "libvisp-dev")
 
-find_package(MRPT 2.0 QUIET COMPONENTS poses kinematics obs maps nav hwdrivers)
-sketchnav_require(MRPT_FOUND "MRPT 2 (poses, kinematics, obs, maps, nav, hwdrivers)" "libmrpt-dev")
+find_package(MRPT 2.0 QUIET COMPONENTS poses kinematics obs maps nav slam hwdrivers)
+sketchnav_require(MRPT_FOUND "MRPT 2 (poses, kinematics, obs, maps, nav, slam, hwdrivers)" "libmrpt-dev")
 
 find_package(nlohmann_json 3 QUIET)
 sketchnav_require(nlohmann_json_FOUND "nlohmann-json" "nlohmann-json3-dev")

@@ -1,19 +1,27 @@
 #!/usr/bin/env bash
 # Landmark recognition benchmark on grocery-packages (issue #6): train on train/, evaluate on
-# val/, one JSON file per configuration plus summary.json, so each part's contribution shows:
-#   rootsift        RootSIFT + BoW/SVM + NN votes + geometric verification (the product)
-#   rootsift_bow    the same model, BoW + linear SVM only (the classic pipeline)
-#   sift, sift_bow  plain SIFT instead of RootSIFT
-#   rootsift_1000   1000 SIFT keypoints per image instead of 500
-#   windows         objectness windows (10 per image) instead of the whole image
-#   frame           each photo letterboxed into a 640x480 frame, recognise + match timed
-#   rejection       three classes left out of training: their val images must be rejected
-#   demo            the product's 8-class demo set (share/landmarks) on all val photos in
-#                   640x480 frames with match: 6 classes known, 14 unknown (to be rejected)
+# val/, one JSON file per configuration plus summary.json and summary.md, so each part's
+# contribution shows in one run:
+#   rootsift         RootSIFT + BoW/SVM + NN votes + colour-checked geometric verification
+#                    (the product's defaults)
+#   rootsift_bow     the same model, BoW + linear SVM only (the classic pipeline)
+#   sift, sift_bow   plain SIFT instead of RootSIFT
+#   no_colour        the product without the keypoint colour check (colour_tolerance 0)
+#   windows          objectness windows (10 per image) instead of the whole image
+#   frame            each photo letterboxed into a 640x480 frame, recognise + match timed
+#   frame_fast       the same with bench/recognition/fast.json (320 px / 400 keypoints for
+#                    frame SIFT, smaller searches): the <= 30 ms per frame setting
+#   rejection        three classes left out of training: their val images must be rejected
+#   rejection_no_colour  the same without the colour check
+#   demo             the product's 8-class demo set (share/landmarks) on all val photos in
+#                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected)
 #
 # Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
 # Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean) with
-# OpenCV on one thread; the machine's load shows in the difference.
+# OpenCV on one thread; the machine's load shows in the difference. Run one benchmark at a
+# time: two would share the cores and the caches.
+# Models are cached in OUT_DIR (retrained when this build cannot read them); delete them after
+# changing the training code without changing the format version.
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -21,11 +29,17 @@ BIN=${1:-$root/build/release/apps/sketchnav}
 DATA=${2:-${SKETCHNAV_DATA:-$root/../shared/data}/grocery-packages}
 OUT=${3:-$root/runs/bench-recognition}
 EXCLUDED=Oatly-Oat-Milk,Yoggi-Vanilla-Yoghurt,Bravo-Orange-Juice
+FAST=$here/fast.json
+NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
 mkdir -p "$OUT"
 
+PROBE=$(find "$DATA/val" -name '*.jpg' | sort | head -1)
+usable() {  # model file: exists and this build can read it (older format versions cannot)
+  [ -f "$1" ] && "$BIN" recognise --model "$1" "$PROBE" >/dev/null 2>&1
+}
 train() {  # name, extra args...
   local name=$1; shift
-  [ -f "$OUT/$name.slm" ] || "$BIN" --json train --landmarks "$DATA/train" -o "$OUT/$name.slm" "$@" \
+  usable "$OUT/$name.slm" || "$BIN" --json train --landmarks "$DATA/train" -o "$OUT/$name.slm" "$@" \
     > "$OUT/train_$name.json"
 }
 evaluate() {  # name, model, extra args...
@@ -36,33 +50,44 @@ evaluate() {  # name, model, extra args...
 
 train rootsift
 train sift --plain-sift
-train rootsift_1000 --max-features 1000
 train rootsift_excluded --exclude "$EXCLUDED"
-[ -f "$OUT/demo.slm" ] || "$BIN" --json train --landmarks "$root/share/landmarks" -o "$OUT/demo.slm" \
+usable "$OUT/demo.slm" || "$BIN" --json train --landmarks "$root/share/landmarks" -o "$OUT/demo.slm" \
   > "$OUT/train_demo.json"
 
 evaluate rootsift rootsift
-evaluate rejection rootsift_excluded
-evaluate frame rootsift --frame 640x480 --match
-evaluate demo demo --frame 640x480 --match
 evaluate rootsift_bow rootsift --no-verify
 evaluate sift sift
 evaluate sift_bow sift --no-verify
+evaluate no_colour rootsift $NO_COLOUR
 evaluate windows rootsift --windows 10
-evaluate rootsift_1000 rootsift_1000
+evaluate frame rootsift --frame 640x480 --match
+evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
+evaluate rejection rootsift_excluded
+evaluate rejection_no_colour rootsift_excluded $NO_COLOUR
+evaluate demo demo --frame 640x480 --match
 
 python3 - "$OUT" <<'PY'
 import json, os, sys
 out = sys.argv[1]
+keys = ("images", "classes", "top1", "top1_ignoring_rejection", "top3", "rejected",
+        "false_rejected", "ms_mean", "cpu_ms_mean", "ms_p95")
 summary = {}
 for f in sorted(os.listdir(out)):
     if f.startswith("eval_") and f.endswith(".json"):
         j = json.load(open(os.path.join(out, f)))
-        summary[f[5:-5]] = {k: j.get(k) for k in ("images", "classes", "top1", "top1_ignoring_rejection", "top3", "rejected",
-                            "false_rejected", "ms_mean", "cpu_ms_mean", "ms_p95")}
+        summary[f[5:-5]] = {k: j.get(k) for k in keys}
     if f.startswith("train_") and f.endswith(".json"):
         j = json.load(open(os.path.join(out, f)))
         summary.setdefault("training", {})[f[6:-5]] = {k: j.get(k) for k in ("seconds", "photos", "words")}
 json.dump(summary, open(os.path.join(out, "summary.json"), "w"), indent=2)
-print(json.dumps(summary, indent=2))
+fmt = lambda v: "–" if v is None else ("%.2f" % v if isinstance(v, float) and v <= 1 else "%.1f" % v if isinstance(v, float) else str(v))
+rows = ["| configuration | top-1 | top-3 | unknown rejected | false rejections | CPU ms / image | wall ms / image |",
+        "|---|---|---|---|---|---|---|"]
+for name, s in summary.items():
+    if name == "training":
+        continue
+    rows.append("| %s | %s | %s | %s | %s | %s | %s |" % (name, fmt(s["top1"]), fmt(s["top3"]), fmt(s["rejected"]),
+                fmt(s["false_rejected"]), fmt(s["cpu_ms_mean"]), fmt(s["ms_mean"])))
+open(os.path.join(out, "summary.md"), "w").write("\n".join(rows) + "\n")
+print("\n".join(rows))
 PY

@@ -16,8 +16,37 @@ struct WindowQuery {
 };
 
 std::vector<int> keypointsInWindow(const FrameFeatures& frame, const cv::Rect& window);
+/// The query restricted to some of its rows (indices into q.idx); no histogram.
+struct WindowQuery;
 WindowQuery makeQuery(const LandmarkModel& model, const FrameFeatures& frame,
                       const std::vector<int>& idx);
+WindowQuery subQuery(const WindowQuery& q, const std::vector<int>& rows);
+/// Whether a window keypoint and a database keypoint have compatible colours (always true
+/// when the tolerance is 0 or either side has no colours).
+class ColourGate {
+ public:
+  ColourGate(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
+             int photo, double tolerance)
+      : frame_(frame.features.colours), q_(q), tol2_(static_cast<float>(tolerance * tolerance)) {
+    if (photo >= 0) db_ = &model.photos()[photo].colours;
+    on_ = tolerance > 0 && !frame_.empty();
+  }
+  void setPhoto(const LandmarkModel& model, int photo) { db_ = &model.photos()[photo].colours; }
+  bool operator()(int query_row, int db_keypoint) const {
+    if (!on_ || !db_ || db_->empty()) return true;
+    return chromaDistance2(frame_.ptr<unsigned char>(q_.idx[query_row]),
+                           db_->ptr<unsigned char>(db_keypoint)) <= tol2_;
+  }
+  bool on() const { return on_; }
+
+ private:
+  const cv::Mat& frame_;
+  const WindowQuery& q_;
+  const cv::Mat* db_ = nullptr;
+  float tol2_;
+  bool on_;
+};
+
 /// BoW cosine similarity of a window histogram to every database photo.
 std::vector<float> photoSimilarities(const LandmarkModel& model, const cv::Mat& hist);
 MatchResult verifyPhoto(const LandmarkModel& model, const FrameFeatures& frame,
@@ -40,12 +69,15 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
 /// class become tentative correspondences of their photos.
 struct Votes {
   std::vector<int> class_votes;
+  // Per class, the window rows with at least one neighbour of that class among the k: the
+  // only rows that can plausibly match that class's photos, so verification searches these.
+  std::vector<std::vector<int>> class_rows;
   std::vector<std::vector<Corr>> photo_corr;  // per database photo
 };
-Votes computeVotes(const LandmarkModel& model, const WindowQuery& q, int knn, double class_ratio,
-                   int checks);
+Votes computeVotes(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
+                   int knn, double class_ratio, int checks, double colour_tolerance);
 
-/// Best of the class's max_photos most similar photos.
+/// Best of the class's max_photos most promising photos (MatchParams::photo_order_checks).
 MatchResult matchClass(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
                        int class_id, const std::vector<float>& sims, const MatchParams& p);
 

@@ -17,14 +17,19 @@ void MatchParams::validate() const {
   require(ratio > 0 && ratio <= 1, "match.ratio", "must be in (0, 1]");
   require(min_inliers >= 4, "match.min_inliers", "must be >= 4 (a homography needs 4 points)");
   require(ransac_px > 0, "match.ransac_px", "must be > 0");
+  require(ransac_iterations >= 10, "match.ransac_iterations", "must be >= 10");
+  require(photo_order_checks >= 0, "match.photo_order_checks", "must be >= 0 (0 = BoW order)");
   require(max_photos >= 1, "match.max_photos", "must be >= 1");
   require(strong_inliers >= min_inliers, "match.strong_inliers", "must be >= min_inliers");
   require(min_window_features >= 4, "match.min_window_features", "must be >= 4");
+  require(colour_tolerance >= 0, "match.colour_tolerance", "must be >= 0 (0 = off)");
+  require(colour_min_fraction >= 0 && colour_min_fraction <= 1, "match.colour_min_fraction",
+          "must be in [0, 1]");
 }
 
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr) {
   FrameFeatures f;
-  f.features = extractFeatures(bgr, model.params().features);
+  f.features = extractFeatures(bgr, model.params().frameFeatures());
   f.words = model.vocabulary().assign(f.features.descriptors);
   return f;
 }
@@ -66,6 +71,17 @@ WindowQuery makeQuery(const LandmarkModel& model, const FrameFeatures& frame,
   return q;
 }
 
+WindowQuery subQuery(const WindowQuery& q, const std::vector<int>& rows) {
+  WindowQuery s;
+  s.idx.resize(rows.size());
+  s.descriptors.create(static_cast<int>(rows.size()), q.descriptors.cols, CV_32F);
+  for (size_t i = 0; i < rows.size(); ++i) {
+    s.idx[i] = q.idx[rows[i]];
+    q.descriptors.row(rows[i]).copyTo(s.descriptors.row(static_cast<int>(i)));
+  }
+  return s;
+}
+
 MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
                         const WindowQuery& q, int photo, std::vector<Corr> corr,
                         const MatchParams& p) {
@@ -82,6 +98,17 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
   corr.erase(std::unique(corr.begin(), corr.end(),
                          [](const Corr& a, const Corr& b) { return a.d == b.d; }),
              corr.end());
+  // Colour check: correspondences whose neighbourhoods differ in chroma are kept out of
+  // RANSAC, and counted afterwards: when most of the geometrically consistent correspondences
+  // have the wrong colour, this is the same artwork on a differently coloured product.
+  std::vector<Corr> wrong_colour;
+  const ColourGate gate(model, frame, q, photo, p.colour_tolerance);
+  if (gate.on()) {
+    std::vector<Corr> ok;
+    ok.reserve(corr.size());
+    for (const auto& c : corr) (gate(c.q, c.d) ? ok : wrong_colour).push_back(c);
+    corr.swap(ok);
+  }
   if (static_cast<int>(corr.size()) < p.min_inliers) return r;
   std::vector<cv::Point2f> src, dst;  // database -> frame
   src.reserve(corr.size());
@@ -91,7 +118,8 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
     dst.push_back(frame.features.keypoints[q.idx[c.q]].pt);
   }
   std::vector<unsigned char> mask;
-  cv::Mat H = cv::findHomography(src, dst, cv::RANSAC, p.ransac_px, mask, 1000, 0.995);
+  cv::Mat H =
+      cv::findHomography(src, dst, cv::RANSAC, p.ransac_px, mask, p.ransac_iterations, 0.995);
   if (H.empty()) return r;
   // A plausible view of a planar-ish package: orientation-preserving, scale within 1/30..30.
   const double det =
@@ -106,7 +134,19 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
     }
   r.inliers = inl;
   r.H = H;
-  if (inl >= p.min_inliers) {
+  int wrong = 0;
+  if (!wrong_colour.empty()) {
+    std::vector<cv::Point2f> ws, wd;
+    for (const auto& c : wrong_colour) ws.push_back(ph.keypoints[c.d].pt);
+    cv::perspectiveTransform(ws, wd, H);
+    const double t2 = p.ransac_px * p.ransac_px;
+    for (size_t i = 0; i < wd.size(); ++i) {
+      const cv::Point2f d = wd[i] - frame.features.keypoints[q.idx[wrong_colour[i].q]].pt;
+      wrong += d.dot(d) <= t2 ? 1 : 0;
+    }
+  }
+  r.wrong_colour = wrong;
+  if (inl >= p.min_inliers && inl >= p.colour_min_fraction * (inl + wrong)) {
     r.matched = true;
     r.confidence = static_cast<float>(1.0 - std::exp(-(inl - p.min_inliers + 1) / 15.0));
   } else {
@@ -134,39 +174,57 @@ MatchResult verifyPhoto(const LandmarkModel& model, const FrameFeatures& frame,
   return ransacPhoto(model, frame, q, photo, std::move(corr), p);
 }
 
-Votes computeVotes(const LandmarkModel& model, const WindowQuery& q, int knn, double class_ratio,
-                   int checks) {
+Votes computeVotes(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
+                   int knn, double class_ratio, int checks, double colour_tolerance) {
   Votes v;
   v.class_votes.assign(model.classes().size(), 0);
   v.photo_corr.resize(model.photos().size());
+  v.class_rows.resize(model.classes().size());
   if (q.descriptors.rows == 0 || model.photos().empty()) return v;
   cv::Mat nn, d2;
   model.knnAll(q.descriptors, knn, checks, nn, d2);
   const float r2 = static_cast<float>(class_ratio * class_ratio);
+  ColourGate gate(model, frame, q, -1, colour_tolerance);
   std::vector<int> seen_photo;
+  std::vector<std::pair<int, int>> owner;  // colour-compatible neighbours: (photo, keypoint)
+  std::vector<float> dist;
   for (int i = 0; i < nn.rows; ++i) {
     const int* id = nn.ptr<int>(i);
     const float* ds = d2.ptr<float>(i);
-    if (id[0] < 0) continue;
-    const int c1 = model.photos()[model.globalOwner(id[0]).first].class_id;
-    float other = std::numeric_limits<float>::infinity();
-    for (int k = 1; k < nn.cols; ++k) {
+    // Neighbours of another colour are not evidence for their class: the same artwork on a
+    // sibling product's differently coloured carton must not out-vote the right product.
+    owner.clear();
+    dist.clear();
+    for (int k = 0; k < nn.cols; ++k) {
       if (id[k] < 0) break;
-      if (model.photos()[model.globalOwner(id[k]).first].class_id != c1) {
-        other = ds[k];
+      const auto o = model.globalOwner(id[k]);
+      auto& rows = v.class_rows[model.photos()[o.first].class_id];
+      if (rows.empty() || rows.back() != i) rows.push_back(i);
+      if (gate.on()) {
+        gate.setPhoto(model, o.first);
+        if (!gate(i, o.second)) continue;
+      }
+      owner.push_back(o);
+      dist.push_back(ds[k]);
+    }
+    if (owner.empty()) continue;
+    const int c1 = model.photos()[owner[0].first].class_id;
+    float other = std::numeric_limits<float>::infinity();
+    for (size_t k = 1; k < owner.size(); ++k)
+      if (model.photos()[owner[k].first].class_id != c1) {
+        other = dist[k];
         break;
       }
-    }
-    if (!(ds[0] < r2 * other)) continue;
+    if (!(dist[0] < r2 * other)) continue;
     ++v.class_votes[c1];
     seen_photo.clear();
-    for (int k = 0; k < nn.cols; ++k) {
-      if (id[k] < 0 || !(ds[k] < r2 * other)) break;
-      const auto [photo, kp] = model.globalOwner(id[k]);
+    for (size_t k = 0; k < owner.size(); ++k) {
+      if (!(dist[k] < r2 * other)) break;
+      const auto [photo, kp] = owner[k];
       if (model.photos()[photo].class_id != c1) break;
       if (std::find(seen_photo.begin(), seen_photo.end(), photo) != seen_photo.end()) continue;
       seen_photo.push_back(photo);
-      v.photo_corr[photo].push_back({i, kp, ds[k]});
+      v.photo_corr[photo].push_back({i, kp, dist[k]});
     }
   }
   return v;
@@ -182,7 +240,30 @@ std::vector<float> photoSimilarities(const LandmarkModel& model, const cv::Mat& 
 MatchResult matchClass(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
                        int class_id, const std::vector<float>& sims, const MatchParams& p) {
   std::vector<int> photos = model.photosOfClass(class_id);
-  std::stable_sort(photos.begin(), photos.end(), [&](int a, int b) { return sims[a] > sims[b]; });
+  if (p.photo_order_checks > 0 && static_cast<int>(photos.size()) > p.max_photos) {
+    // The photos where most window descriptors find their nearest class neighbour first. The
+    // search covers the whole frame once per class and is cached in the frame's features.
+    std::vector<int> v(model.photos().size(), 0);
+    if (frame.photo_cache) {
+      std::lock_guard<std::mutex> lock(frame.photo_cache->mutex);
+      auto& nearest =
+          frame.photo_cache
+              ->nearest[{static_cast<const void*>(&model), class_id, p.photo_order_checks}];
+      if (nearest.empty())
+        nearest =
+            model.classNearestPhoto(class_id, frame.features.descriptors, p.photo_order_checks);
+      for (int i : q.idx)
+        if (i < static_cast<int>(nearest.size()) && nearest[i] >= 0 &&
+            nearest[i] < static_cast<int>(v.size()))
+          ++v[nearest[i]];
+    } else {
+      v = model.classPhotoVotes(class_id, q.descriptors, p.photo_order_checks);
+    }
+    std::stable_sort(photos.begin(), photos.end(),
+                     [&](int a, int b) { return v[a] != v[b] ? v[a] > v[b] : sims[a] > sims[b]; });
+  } else {
+    std::stable_sort(photos.begin(), photos.end(), [&](int a, int b) { return sims[a] > sims[b]; });
+  }
   MatchResult best;
   int tried = 0;
   for (int ph : photos) {

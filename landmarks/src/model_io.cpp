@@ -4,7 +4,8 @@
 //   magic "SKNVLMDL" (8 bytes) | u32 format version | u64 payload size | u64 FNV-1a(payload)
 //   payload: params JSON, landmark set fingerprint, class names, vocabulary centres + IDF,
 //            classifier weights + rho + Platt (a, b), then per photo: class, path, size,
-//            keypoints (x, y, size, angle, response, octave), raw SIFT (N x 128 u8), words.
+//            keypoints (x, y, size, angle, response, octave), raw SIFT (N x 128 u8),
+//            keypoint colours (N x 3 u8, since version 3), words.
 // Working descriptors (RootSIFT) and histograms are recomputed on load: they are derived.
 #include <opencv2/flann.hpp>
 // After flann.hpp, which it needs (cvflann::seed_random).
@@ -105,6 +106,14 @@ struct LandmarkModel::Cache {
   cv::Mat global_descriptors;                     // all photos' descriptors, stacked
   std::vector<std::pair<int, int>> global_owner;  // row -> (photo, keypoint)
   std::unique_ptr<cv::flann::Index> global_index;
+  // Per class: its photos' descriptors stacked, row -> photo, and a kd-tree (built lazily).
+  struct PerClass {
+    std::once_flag once;
+    cv::Mat descriptors;
+    std::vector<int> photo;
+    std::unique_ptr<cv::flann::Index> index;
+  };
+  std::unique_ptr<PerClass[]> per_class;
 };
 
 LandmarkModel::LandmarkModel() : cache_(std::make_unique<Cache>()) {}
@@ -128,6 +137,7 @@ void LandmarkModel::finalise() {
     by_class_[ph.class_id].push_back(static_cast<int>(i));
   }
   cache_ = std::make_unique<Cache>();
+  cache_->per_class = std::make_unique<Cache::PerClass[]>(classes_.size());
 }
 
 void LandmarkModel::knn2(int photo, const cv::Mat& query, cv::Mat& indices, cv::Mat& dists) const {
@@ -167,6 +177,48 @@ void LandmarkModel::knnAll(const cv::Mat& query, int k, int checks, cv::Mat& ind
   cache_->global_index->knnSearch(query, indices, dists, k, cv::flann::SearchParams(checks));
 }
 
+std::vector<int> LandmarkModel::classPhotoVotes(int class_id, const cv::Mat& query,
+                                                int checks) const {
+  std::vector<int> votes(photos_.size(), 0);
+  for (int p : classNearestPhoto(class_id, query, checks))
+    if (p >= 0) ++votes[p];
+  return votes;
+}
+
+std::vector<int> LandmarkModel::classNearestPhoto(int class_id, const cv::Mat& query,
+                                                  int checks) const {
+  std::vector<int> out(query.rows, -1);
+  if (class_id < 0 || class_id >= static_cast<int>(classes_.size()) || query.empty()) return out;
+  if (!cache_->per_class) return out;  // created by finalise()
+  Cache::PerClass& pc = cache_->per_class[class_id];
+  std::call_once(pc.once, [&] {
+    int n = 0;
+    for (int p : by_class_[class_id]) n += photos_[p].descriptors.rows;
+    pc.descriptors.create(n, 128, CV_32F);
+    pc.photo.resize(n);
+    int r = 0;
+    for (int p : by_class_[class_id]) {
+      const cv::Mat& d = photos_[p].descriptors;
+      d.copyTo(pc.descriptors.rowRange(r, r + d.rows));
+      std::fill(pc.photo.begin() + r, pc.photo.begin() + r + d.rows, p);
+      r += d.rows;
+    }
+    if (n > 0) {
+      cvflann::seed_random(4243);  // reproducible trees
+      pc.index =
+          std::make_unique<cv::flann::Index>(pc.descriptors, cv::flann::KDTreeIndexParams(2));
+    }
+  });
+  if (!pc.index) return out;
+  cv::Mat idx, dist;
+  pc.index->knnSearch(query, idx, dist, 1, cv::flann::SearchParams(checks));
+  for (int i = 0; i < idx.rows; ++i) {
+    const int r = idx.at<int>(i, 0);
+    if (r >= 0 && r < static_cast<int>(pc.photo.size())) out[i] = pc.photo[r];
+  }
+  return out;
+}
+
 void LandmarkModel::buildIndexes() const {
   cv::Mat idx, dist;
   if (photos_.empty()) return;
@@ -174,6 +226,7 @@ void LandmarkModel::buildIndexes() const {
       photos_[0].descriptors.rowRange(0, std::min(1, photos_[0].descriptors.rows));
   if (probe.empty()) return;
   knnAll(probe, 2, 1, idx, dist);
+  for (size_t c = 0; c < classes_.size(); ++c) classPhotoVotes(static_cast<int>(c), probe, 1);
 }
 
 std::pair<int, int> LandmarkModel::globalOwner(int row) const {
@@ -208,6 +261,7 @@ void LandmarkModel::save(const std::string& path) const {
       w.put<std::int32_t>(k.octave);
     }
     w.mat(ph.sift_u8.empty() ? cv::Mat(0, 128, CV_8U) : ph.sift_u8);
+    w.mat(ph.colours.empty() ? cv::Mat(0, 3, CV_8U) : ph.colours);
     w.mat(cv::Mat(ph.words, true).reshape(1, 1));
   }
   const std::string& payload = w.buffer();
@@ -304,8 +358,11 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
       k.octave = r.get<std::int32_t>();
     }
     ph.sift_u8 = r.mat();
+    ph.colours = r.mat();
     cv::Mat words = r.mat();
-    if (ph.sift_u8.rows != static_cast<int>(nk) || words.total() != nk) r.corrupt("photo");
+    if (ph.sift_u8.rows != static_cast<int>(nk) || words.total() != nk ||
+        ph.colours.rows != static_cast<int>(nk) || ph.colours.cols != 3)
+      r.corrupt("photo");
     ph.words.assign(words.begin<int>(), words.end<int>());
     for (int wd : ph.words)
       if (wd < 0 || wd >= centres.rows) r.corrupt("word index");

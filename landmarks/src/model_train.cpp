@@ -21,6 +21,8 @@ void ModelParams::validate() const {
   require(kmeans_sample >= 100, "train.kmeans_sample", "must be >= 100");
   require(kmeans_iterations >= 1, "train.kmeans_iterations", "must be >= 1");
   require(svm_c > 0, "train.svm_c", "must be > 0");
+  require(frame_max_features >= 0, "train.frame_max_features", "must be >= 0");
+  require(frame_max_image_side >= 64, "train.frame_max_image_side", "must be >= 64 px");
   require(seed >= 0, "train.seed", "must be >= 0");
 }
 
@@ -78,6 +80,7 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
     ph.path = fs::relative(items[i].path, set.root).string();
     ph.size = img.size();
     detectSift(img, params.features, ph.keypoints, ph.sift_u8);
+    ph.colours = keypointColours(img, ph.keypoints);
     if (ph.keypoints.size() < 5) {
       log::warn("landmarks", "skipping photo with too little texture",
                 {{"file", items[i].path}, {"features", std::to_string(ph.keypoints.size())}});

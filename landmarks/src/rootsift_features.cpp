@@ -81,12 +81,56 @@ cv::Mat workingDescriptors(const cv::Mat& sift_u8, bool root_sift) {
   return d;
 }
 
+cv::Mat keypointColours(const cv::Mat& image, const std::vector<cv::KeyPoint>& kps) {
+  if (image.empty() || kps.empty() || image.channels() < 3) return {};
+  cv::Mat bgr = image;
+  if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
+  if (bgr.depth() != CV_8U) bgr.convertTo(bgr, CV_8U);
+  // Box means from an integral image of a reduced copy: the colour of a keypoint's
+  // neighbourhood, not of single (noisy, specular) pixels, for well under 1 ms per frame.
+  constexpr int kSide = 640;
+  const double s = std::min(1.0, static_cast<double>(kSide) / std::max(bgr.cols, bgr.rows));
+  cv::Mat small;
+  if (s < 1)
+    cv::resize(bgr, small, cv::Size(), s, s, cv::INTER_AREA);
+  else
+    small = bgr;
+  cv::Mat integ;
+  cv::integral(small, integ, CV_32S);
+  const int n = static_cast<int>(kps.size());
+  cv::Mat out(n, 3, CV_8U);
+  for (int i = 0; i < n; ++i) {
+    const float r = std::max(1.0f, 0.5f * kps[i].size * static_cast<float>(s));
+    const float cx = kps[i].pt.x * static_cast<float>(s), cy = kps[i].pt.y * static_cast<float>(s);
+    const int x0 = std::clamp(static_cast<int>(std::floor(cx - r)), 0, small.cols - 1);
+    const int y0 = std::clamp(static_cast<int>(std::floor(cy - r)), 0, small.rows - 1);
+    const int x1 = std::clamp(static_cast<int>(std::ceil(cx + r)), x0 + 1, small.cols);
+    const int y1 = std::clamp(static_cast<int>(std::ceil(cy + r)), y0 + 1, small.rows);
+    const auto a = integ.at<cv::Vec3i>(y0, x0), b = integ.at<cv::Vec3i>(y0, x1),
+               c = integ.at<cv::Vec3i>(y1, x0), d = integ.at<cv::Vec3i>(y1, x1);
+    const float area = static_cast<float>((x1 - x0) * (y1 - y0));
+    float m[3];  // mean B, G, R in [0, 255]
+    for (int k = 0; k < 3; ++k) m[k] = static_cast<float>(d[k] - b[k] - c[k] + a[k]) / area;
+    // Opponent chromaticities divided by the intensity: unchanged when the light gets brighter
+    // or dimmer (shading, exposure); the +30 pulls near-black patches, whose hue is noise,
+    // towards neutral.
+    const float inv = 1.0f / (m[0] + m[1] + m[2] + 30.0f);
+    const float c1 = (m[2] - m[1]) * inv;                // red - green, in (-1, 1)
+    const float c2 = (m[2] + m[1] - 2.0f * m[0]) * inv;  // yellow - blue, in (-2, 1)
+    out.at<unsigned char>(i, 0) = cv::saturate_cast<unsigned char>((m[0] + m[1] + m[2]) / 3.0f);
+    out.at<unsigned char>(i, 1) = cv::saturate_cast<unsigned char>(128.0f + 100.0f * c1);
+    out.at<unsigned char>(i, 2) = cv::saturate_cast<unsigned char>(128.0f + 60.0f * c2);
+  }
+  return out;
+}
+
 Features extractFeatures(const cv::Mat& image, const FeatureParams& p) {
   Features f;
   f.image_size = image.size();
   cv::Mat u8;
   detectSift(image, p, f.keypoints, u8);
   f.descriptors = workingDescriptors(u8, p.root_sift);
+  f.colours = keypointColours(image, f.keypoints);
   return f;
 }
 

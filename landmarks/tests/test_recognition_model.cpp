@@ -3,6 +3,8 @@
 #include <filesystem>
 #include <fstream>
 
+#include <opencv2/imgproc.hpp>
+
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/model.h"
@@ -232,6 +234,108 @@ TEST_F(TinyModel, LoadOrTrainReusesAFreshCacheAndRetrainsAStaleOne) {
   const LandmarkModel c = loadOrTrainModel(root_, cache, tinyParams());
   EXPECT_EQ(c.classes(), a.classes());
   EXPECT_NO_THROW(LandmarkModel::load(cache));
+}
+
+TEST_F(TinyModel, AnOlderFormatIsRefusedAndACachedOneRetrained) {
+  // Version 1 files (no keypoint colours) must not be read as the current version: it names
+  // the version and says to retrain, and the run harness's cache retrains instead of failing.
+  ASSERT_GE(LandmarkModel::kFormatVersion, 3u);
+  const std::string dir = test::tempDir("recog-v1");
+  model_->save(dir + "/m.slm");
+  std::string data = readAll(dir + "/m.slm");
+  data[8] = 1;
+  data[9] = data[10] = data[11] = 0;
+  writeAll(dir + "/v1.slm", data);
+  try {
+    LandmarkModel::load(dir + "/v1.slm");
+    FAIL() << "a version 1 model was accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("version 1"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("retrain"), std::string::npos) << msg;
+  }
+  const LandmarkModel m = loadOrTrainModel(root_, dir + "/v1.slm", tinyParams());
+  EXPECT_EQ(m.classes(), model_->classes());
+  EXPECT_NO_THROW(LandmarkModel::load(dir + "/v1.slm")) << "the cache was rewritten";
+}
+
+TEST_F(TinyModel, KeypointColoursAreStoredPerDatabaseKeypoint) {
+  for (const auto& ph : model_->photos()) {
+    ASSERT_EQ(ph.colours.rows, static_cast<int>(ph.keypoints.size())) << ph.path;
+    ASSERT_EQ(ph.colours.cols, 3);
+  }
+}
+
+namespace {
+// The same artwork in other colours: L* kept, (a*, b*) negated, so SIFT (grey levels) sees
+// nearly the same image while every coloured region changes hue, as between sibling products.
+cv::Mat oppositeColours(const cv::Mat& bgr) {
+  cv::Mat lab;
+  cv::cvtColor(bgr, lab, cv::COLOR_BGR2Lab);
+  for (auto it = lab.begin<cv::Vec3b>(); it != lab.end<cv::Vec3b>(); ++it) {
+    (*it)[1] = cv::saturate_cast<uchar>(256 - (*it)[1]);
+    (*it)[2] = cv::saturate_cast<uchar>(256 - (*it)[2]);
+  }
+  cv::Mat out;
+  cv::cvtColor(lab, out, cv::COLOR_Lab2BGR);
+  return out;
+}
+}  // namespace
+
+TEST(ColourCheck, TellsSiblingProductsApartAndRejectsAnUnknownSibling) {
+  const cv::Mat artwork = test::texturedImage(240, 180, 1000);
+  const cv::Mat sibling = oppositeColours(artwork);
+  const std::string root = test::tempDir("recog-siblings");
+  auto writeClass = [&](const std::string& name, const cv::Mat& obj, unsigned seed) {
+    fs::create_directories(root + "/" + name);
+    for (int i = 0; i < 4; ++i)
+      cv::imwrite(root + "/" + name + "/p" + std::to_string(i) + ".png",
+                  test::randomView(obj, 320, 240, seed + i, 20));
+  };
+  writeClass("orange", artwork, 100);
+  writeClass("other", test::texturedImage(240, 180, 1001), 300);
+  // Only "orange" and "other" known: a view of the sibling must be "none of these" — and is
+  // accepted as "orange" when the colour check is off (so the check is what rejects it).
+  const LandmarkModel known = trainModel(root, tinyParams());
+  RecognitionParams on, off;
+  off.match.colour_tolerance = 0;
+  ASSERT_GT(on.match.colour_tolerance, 0);
+  int rejected_on = 0, accepted_off = 0;
+  for (int i = 0; i < 3; ++i) {
+    const cv::Mat view = test::randomView(sibling, 320, 240, 900 + i, 15);
+    const auto a = recognise(known, view, {}, 1, on), b = recognise(known, view, {}, 1, off);
+    ASSERT_FALSE(a.empty());
+    ASSERT_FALSE(b.empty());
+    rejected_on += a[0].rejected;
+    accepted_off += !b[0].rejected && b[0].class_name == "orange";
+  }
+  EXPECT_EQ(rejected_on, 3);
+  EXPECT_EQ(accepted_off, 3);
+  // Both siblings known: each held-out view goes to its own colour.
+  writeClass("green", sibling, 200);
+  const LandmarkModel both = trainModel(root, tinyParams());
+  int correct = 0;
+  for (int i = 0; i < 3; ++i) {
+    const auto a = recognise(both, test::randomView(artwork, 320, 240, 700 + i, 15), {}, 1, on);
+    const auto b = recognise(both, test::randomView(sibling, 320, 240, 800 + i, 15), {}, 1, on);
+    correct += !a.empty() && !a[0].rejected && a[0].class_name == "orange";
+    correct += !b.empty() && !b[0].rejected && b[0].class_name == "green";
+  }
+  EXPECT_GE(correct, 5) << "of 6 sibling views";
+}
+
+TEST(RecognitionParams, ValidateNamesTheField) {
+  RecognitionParams p;
+  p.max_verified_photos = -1;
+  EXPECT_THROW(p.validate(), InputError);
+  p = RecognitionParams{};
+  p.match.colour_tolerance = -1;
+  try {
+    p.validate();
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("colour_tolerance"), std::string::npos);
+  }
 }
 
 TEST(ModelParams, ValidateNamesTheField) {

@@ -70,6 +70,39 @@ TEST(RootSift, ExtractedFeaturesAreRootSiftAndInImagePixels) {
   EXPECT_GT(cv::norm(g.descriptors.row(0)), 10.0) << "plain SIFT is not normalised to 1";
 }
 
+TEST(KeypointColours, ChromaOfTheNeighbourhoodAndNothingForGrey) {
+  // Left half red, right half green, same texture (grey levels) on both.
+  cv::Mat img(200, 400, CV_8UC3);
+  img(cv::Rect(0, 0, 200, 200)).setTo(cv::Scalar(40, 40, 200));
+  img(cv::Rect(200, 0, 200, 200)).setTo(cv::Scalar(40, 160, 40));
+  std::vector<cv::KeyPoint> kps = {{cv::Point2f(100, 100), 20.f},
+                                   {cv::Point2f(300, 100), 20.f},
+                                   {cv::Point2f(0, 0), 4.f},
+                                   {cv::Point2f(399, 199), 60.f}};
+  const cv::Mat c = keypointColours(img, kps);
+  ASSERT_EQ(c.rows, 4);
+  ASSERT_EQ(c.cols, 3);
+  ASSERT_EQ(c.type(), CV_8U);
+  EXPECT_GT(c.at<unsigned char>(0, 1), 128 + 40) << "red: a* > 0";
+  EXPECT_LT(c.at<unsigned char>(1, 1), 128 - 40) << "green: a* < 0";
+  EXPECT_GT(chromaDistance2(c.ptr<unsigned char>(0), c.ptr<unsigned char>(1)), 80.f * 80.f);
+  EXPECT_EQ(chromaDistance2(c.ptr<unsigned char>(0), c.ptr<unsigned char>(2)), 0.f)
+      << "a keypoint at the image corner is clamped, not out of bounds";
+  // Lightness does not count: a darker red is the same chroma class.
+  cv::Mat dark;
+  img.convertTo(dark, -1, 0.6);
+  const cv::Mat d = keypointColours(dark, kps);
+  EXPECT_LT(chromaDistance2(c.ptr<unsigned char>(0), d.ptr<unsigned char>(0)), 20.f * 20.f);
+  EXPECT_NE(c.at<unsigned char>(0, 0), d.at<unsigned char>(0, 0)) << "L differs";
+  cv::Mat grey;
+  cv::cvtColor(img, grey, cv::COLOR_BGR2GRAY);
+  EXPECT_TRUE(keypointColours(grey, kps).empty());
+  EXPECT_TRUE(keypointColours(img, {}).empty());
+  // extractFeatures fills one colour per keypoint.
+  const Features f = extractFeatures(sketchnav::test::texturedImage(320, 240, 5), FeatureParams{});
+  EXPECT_EQ(f.colours.rows, static_cast<int>(f.keypoints.size()));
+}
+
 TEST(Vocabulary, SameSeedSameWords) {
   cv::Mat d = rootSift(randomSift(3000, 9));
   VocabularyParams p;

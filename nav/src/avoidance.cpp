@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Core>
+
 #include "sketchnav/core/config.h"
 #include "sketchnav/nav/sections.h"
 
@@ -34,6 +36,9 @@ void AvoidParams::validate() const {
   require(max_range_m > trigger_m, "nav.avoid.max_range_m", "must be > trigger_m");
   require(side_bias_deg >= 0 && side_bias_deg < 90, "nav.avoid.side_bias_deg",
           "must be in [0, 90)");
+  require(moving_side_bias_deg >= 0 && moving_side_bias_deg < 90, "nav.avoid.moving_side_bias_deg",
+          "must be in [0, 90)");
+  require(same_side_s >= 0, "nav.avoid.same_side_s", "must be >= 0");
   require(min_active_s >= 0, "nav.avoid.min_active_s", "must be >= 0");
   require(k_heading > 0, "nav.avoid.k_heading", "must be > 0");
   require(sectors >= 36 && sectors <= 1440, "nav.avoid.sectors", "must be in [36, 1440]");
@@ -117,7 +122,51 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
   const bool fresh = stamp > prev_stamp_ + 1e-9;
   const bool straight = std::abs(wrapAngle(heading - prev_heading_)) < 0.05;
-  if (fresh) {
+  if (fresh && have_pose_) {
+    // With the robot's pose: follow the nearest obstacle point in front (odometry frame) from
+    // scan to scan. A point on something static only slides along its surface (across the
+    // line of sight); a pedestrian's comes towards the robot. Works while turning too.
+    // The point followed is the one closing the corridor ahead (else the nearest within
+    // 35 degrees): what the robot would run into, not the nearest thing beside it.
+    double best = 1e300;
+    Eigen::Vector2d near(0, 0);
+    for (const auto& [x, y] : pts) {
+      const double cw = hw + 0.15;
+      if (x > 0 && std::abs(y) < cw && x < P.max_range_m + 1.0) {
+        const double touch = x - std::sqrt(cw * cw - y * y);
+        if (touch < best) best = touch, near = {x, y};
+      }
+    }
+    if (best >= 1e300)
+      for (const auto& [x, y] : pts) {
+        const double r = std::hypot(x, y);
+        if (r < best && r < P.max_range_m + 1.0 && std::abs(std::atan2(y, x)) <= 0.6)
+          best = r, near = {x, y};
+      }
+    if (best < 1e300) {
+      const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
+      const Eigen::Vector2d robot(pose_.x, pose_.y);
+      const Eigen::Vector2d world =
+          robot + Eigen::Vector2d(c * near.x() - sn * near.y(), sn * near.x() + c * near.y());
+      const double dt = stamp - prev_pt_t_;
+      if (have_prev_pt_ && dt > 1e-6 && dt < 0.5 && (world - prev_pt_).norm() < 0.3) {
+        const Eigen::Vector2d vel = (world - prev_pt_) / dt;
+        const Eigen::Vector2d los = (world - robot).normalized();
+        const double rate = -vel.dot(los);  // > 0: coming towards the robot
+        approach_ = 0.6 * approach_ + 0.4 * std::clamp(rate, -2.0, 2.0);
+      } else {
+        approach_ *= 0.5;
+      }
+      prev_pt_ = world;
+      prev_pt_t_ = stamp;
+      have_prev_pt_ = true;
+    } else {
+      approach_ = 0;
+      have_prev_pt_ = false;
+    }
+    prev_heading_ = heading;
+    prev_stamp_ = stamp;
+  } else if (fresh) {
     if (!straight) {
       approach_ *= 0.5;
     } else if (prev_free_ >= 0 && stamp > prev_t_ + 1e-6 &&
@@ -157,6 +206,9 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
     };
     const double left = room(+1), right = room(-1);
     side_ = landmark_side;
+    // A manoeuvre right after another keeps its side: crossing over in front of the same
+    // pedestrian (or round the far side of the same obstacle) is how near-misses happen.
+    if (last_side_ != DodgeSide::None && now - last_end_t_ <= P.same_side_s) side_ = last_side_;
     if (side_ == DodgeSide::None) side_ = left >= right ? DodgeSide::Left : DodgeSide::Right;
     // The landmark's side is preferred unless it is closed while the other is open.
     const double mine = side_ == DodgeSide::Left ? left : right;
@@ -168,6 +220,8 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
     active_ = false;
     prev_v_ = v_nominal;
     out.ended = true;
+    last_side_ = side_;
+    last_end_t_ = now;
     out.side = side_;
     out.original_heading = original_heading_;
     side_ = DodgeSide::None;
@@ -205,7 +259,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
     }
   }
   const double sgn = side_ == DodgeSide::Left ? 1.0 : -1.0;
-  const double bias = sgn * P.side_bias_deg * M_PI / 180;
+  const double bias = sgn * (moving > 0 ? P.moving_side_bias_deg : P.side_bias_deg) * M_PI / 180;
   const double tb = wrapAngle(target_bearing + bias);
   mrpt::nav::CAbstractHolonomicReactiveMethod::NavInput ni;
   ni.obstacles = obst;

@@ -38,6 +38,23 @@ void ExecutiveParams::validate() const {
   require(attend_range_m > 0, "nav.attend_range_m", "must be > 0");
   require(max_missed_in_row >= 0, "nav.max_missed_in_row", "must be >= 0");
   require(goal_stop_s >= 0, "nav.goal_stop_s", "must be >= 0");
+  require(dock_m >= 0, "nav.dock_m", "must be >= 0");
+  require(fit_fixes == 0 || fit_fixes >= 3, "nav.fit_fixes", "must be 0 (off) or >= 3");
+  require(fit_min_span_m >= 0, "nav.fit_min_span_m", "must be >= 0");
+  require(fit_max_scale_change >= 0 && fit_max_scale_change < 1, "nav.fit_max_scale_change",
+          "must be in [0, 1)");
+  require(fit_local_gain >= 0 && fit_local_gain <= 1, "nav.fit_local_gain", "must be in [0, 1]");
+  require(stuck_s > 0, "nav.stuck_s", "must be > 0");
+  require(goal_settle_m >= 0, "nav.goal_settle_m", "must be >= 0");
+  require(goal_settle_s > 0, "nav.goal_settle_s", "must be > 0");
+  require(stuck_m >= 0, "nav.stuck_m", "must be >= 0");
+  require(recover_m > 0, "nav.recover_m", "must be > 0");
+  require(recover_s > 0, "nav.recover_s", "must be > 0");
+  require(look_range_m >= 0, "nav.look_range_m", "must be >= 0");
+  require(look_max_bearing_deg > 0 && look_max_bearing_deg <= 180, "nav.look_max_bearing_deg",
+          "must be in (0, 180]");
+  require(look_bearing_deg > 0 && look_bearing_deg <= 90, "nav.look_bearing_deg",
+          "must be in (0, 90]");
 }
 
 NavSettings navSettingsFrom(const Config& c) {
@@ -47,6 +64,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.select, c, "nav.select");
   applyConfig(s.avoid, c, "nav.avoid");
   applyConfig(s.safety, c, "nav.safety");
+  applyConfig(s.laser_odometry, c, "nav.laser_odometry");
   applyConfig(s.servo, c, "servo");
   return s;
 }
@@ -87,7 +105,14 @@ json ExecutiveSummary::toJson() const {
           {"objectness_ms_mean", objectness_ms_mean},
           {"features_ms_mean", features_ms_mean},
           {"match_ms_mean", match_ms_mean},
-          {"avoidance_manoeuvres", avoidance_manoeuvres}};
+          {"avoidance_manoeuvres", avoidance_manoeuvres},
+          {"recoveries", recoveries},
+          {"laser_odometry",
+           {{"scans", laser_odometry.scans},
+            {"aligned", laser_odometry.aligned},
+            {"rejected", laser_odometry.rejected},
+            {"keyframes", laser_odometry.keyframes},
+            {"ms_mean", laser_odometry.ms_mean}}}};
 }
 
 namespace {
@@ -108,6 +133,8 @@ struct LmTrack {
   LmState state = LmState::Pending;
   int frames_seen = 0, max_inliers = 0;
   double last_seen = -1e300, last_range = 0, last_bearing = 0;
+  bool have_fix = false;           // a ranged sighting exists (last_fix is valid)
+  Eigen::Vector2d last_fix{0, 0};  // where that sighting put the landmark (odometry frame)
 };
 }  // namespace
 
@@ -120,6 +147,7 @@ struct Executive::Impl {
   servo::TurnLaw law;
   ObstacleAvoider avoider;
   SafetySupervisor safety;
+  LaserOdometry lodo;
 
   RunStatus status = RunStatus::Idle;
   std::string reason;
@@ -139,7 +167,16 @@ struct Executive::Impl {
   std::vector<std::string> missed_ids;
   double last_perception_t = -1e300;
   bool sectionBlocked_ = false;
-  Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};  // last trusted fix (start, then landmarks)
+  // Stuck recovery: where the robot was stuck_s ago, and an escape under way.
+  hw::Pose2D stuck_ref;
+  double stuck_t = 0;
+  bool recovering = false;
+  double rec_dir = 0, rec_t0 = 0;  // escape heading (odometry frame), start time
+  hw::Pose2D rec_from;
+  int recoveries = 0;
+  double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
+  Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
+  std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -149,7 +186,8 @@ struct Executive::Impl {
         obs(o),
         law(st.servo),
         avoider(st.avoid),
-        safety(st.safety) {
+        safety(st.safety),
+        lodo(st.laser_odometry) {
     s.exec.validate();
     s.select.validate();
     if (!dev.base || !dev.clock) throw std::logic_error("Executive: base and clock are required");
@@ -197,11 +235,13 @@ struct Executive::Impl {
     return r[r.size() / 2];
   }
 
-  void markMissed(int sec, int i) {
+  // `counts`: towards "lost: N in a row". A landmark left behind one that was passed after it
+  // does not count: the robot knows where it is.
+  void markMissed(int sec, int i, bool counts = true) {
     auto& tr = tracks[sec][i];
     const auto& lm = tracker.route().sections[sec].landmarks[i];
     tr.state = LmState::Missed;
-    ++missed_in_row;
+    if (counts) ++missed_in_row;
     missed_ids.push_back(lm.id);
     event({{"type", "landmark_missed"},
            {"id", lm.id},
@@ -226,8 +266,9 @@ struct Executive::Impl {
     if (dev.base->odometry(o) && o.stamp > odom_stamp) {
       odom_stamp = o.stamp;
       safety.odometry(o.stamp);
-      if (have_pose) path_m += std::hypot(o.pose.x - pose.x, o.pose.y - pose.y);
-      pose = o.pose;
+      const hw::Pose2D p = lodo.wheel(o.pose, o.stamp);
+      if (have_pose) path_m += std::hypot(p.x - pose.x, p.y - pose.y);
+      pose = p;
       have_pose = true;
     }
     for (size_t i = 0; i < dev.ranges.size(); ++i) {
@@ -235,9 +276,11 @@ struct Executive::Impl {
       if (dev.ranges[i]->read(sc) && sc.stamp > scan_stamps[i]) {
         scan_stamps[i] = sc.stamp;
         safety.rangeScan(sc.stamp);
+        if (have_pose) lodo.scan(sc);
         scans[i] = std::move(sc);
       }
     }
+    if (have_pose) pose = lodo.pose();
     hw::Frame frame;
     bool have_frame = false;
     if (dev.camera && now + 1e-9 >= frame_stamp + s.exec.camera_period_s - 0.5 * s.exec.tick_s) {
@@ -293,88 +336,131 @@ struct Executive::Impl {
     const auto prog = tracker.progress(pose);
 
     // --- landmark stage ------------------------------------------------------------------
-    // The landmark to attend to: the first one of this section not yet passed or missed, or
-    // else the first of the next section (a landmark just past a guide point is often in
-    // view before that section starts).
-    int lk = -1, li = -1;
-    for (int kk = k; kk < std::min(k + 2, tracker.count()) && li < 0; ++kk) {
+    // Attended landmarks: the first one of this section not yet passed or missed (or else the
+    // first of the next section: a landmark just past a guide point is often in view before
+    // that section starts), and the one after it. The robot servos on the first only; the
+    // second is looked for in the same frames because it often comes into view while the
+    // first is still expected (two landmarks a few metres apart on opposite sides of the path)
+    // and is too close to be recognised by the time the first is passed.
+    struct Attended {
+      int k, i;
+      const mapsketch::ExpectedLandmark* lm;
+      LmTrack* tr;
+      Polar pred;
+      bool attend;
+    };
+    std::vector<Attended> att;
+    for (int kk = k; kk < std::min(k + 2, tracker.count()) && att.size() < 2; ++kk) {
       const auto& ss = tracker.route().sections[kk];
-      for (size_t i = 0; i < ss.landmarks.size(); ++i) {
+      for (size_t i = 0; i < ss.landmarks.size() && att.size() < 2; ++i) {
         auto& t = tracks[kk][i];
         if (t.state == LmState::Passed || t.state == LmState::Missed) continue;
-        if (kk == k && prog.along_m > ss.landmarks[i].along_m + s.exec.miss_slack_m &&
+        if (kk == k &&
+            prog.along_m > ss.landmarks[i].along_m * tracker.scale() + s.exec.miss_slack_m &&
             t.state == LmState::Pending) {
-          markMissed(kk, static_cast<int>(i));
+          // Recognised earlier but lost from view before it was close: the robot did see it,
+          // so it is passed (a sighting says the route is right), not missed.
+          if (t.frames_seen > 0)
+            passLandmark(kk, static_cast<int>(i), false);
+          else
+            markMissed(kk, static_cast<int>(i));
           if (status != RunStatus::Running) return;
           continue;
         }
-        lk = kk;
-        li = static_cast<int>(i);
-        break;
+        const auto& l = ss.landmarks[i];
+        const Polar p = polarFrom(pose, tracker.toOdom(l.position_m));
+        const bool a = t.state == LmState::Tracking ||
+                       (std::abs(p.bearing) <= s.exec.attend_bearing_deg * M_PI / 180 &&
+                        p.range <= s.exec.attend_range_m);
+        att.push_back({kk, static_cast<int>(i), &l, &t, p, a});
       }
-      if (kk == k && li < 0) continue;
-      if (kk > k) break;
     }
-    const mapsketch::ExpectedLandmark* lm =
-        li >= 0 ? &tracker.route().sections[lk].landmarks[li] : nullptr;
-    LmTrack* tr = li >= 0 ? &tracks[lk][li] : nullptr;
+    const mapsketch::ExpectedLandmark* lm = att.empty() ? nullptr : att[0].lm;
+    LmTrack* tr = att.empty() ? nullptr : att[0].tr;
     double servo_error = std::numeric_limits<double>::quiet_NaN();
-    const Polar pred = lm ? polarFrom(pose, tracker.toOdom(lm->position_m)) : Polar{};
-    const bool attend = lm && (tr->state == LmState::Tracking ||
-                               (std::abs(pred.bearing) <= s.exec.attend_bearing_deg * M_PI / 180 &&
-                                pred.range <= s.exec.attend_range_m));
-    if (attend && have_frame && now - last_perception_t >= s.exec.perception_period_s - 1e-6) {
+    const Polar pred = att.empty() ? Polar{} : att[0].pred;
+    std::vector<std::string> classes;
+    for (const auto& x : att)
+      if (x.attend && std::find(classes.begin(), classes.end(), x.lm->class_name) == classes.end())
+        classes.push_back(x.lm->class_name);
+    if (!classes.empty() && have_frame &&
+        now - last_perception_t >= s.exec.perception_period_s - 1e-6) {
       last_perception_t = now;
-      const auto ob = perception.observe(frame, K, {lm->class_name});
+      const auto ob = perception.observe(frame, K, classes);
       ++processed;
       perc_sum += ob.timing.total_ms;
       perc_max = std::max(perc_max, ob.timing.total_ms);
       objn_sum += ob.timing.objectness_ms;
       feat_sum += ob.timing.features_ms;
       match_sum += ob.timing.match_ms;
-      std::vector<Candidate> cands;
-      for (const auto& d : ob.detections) cands.push_back({&d, rangeAt(d.bearing)});
-      const int ci = selectCandidate(cands, lm->class_name, pred.bearing, pred.range, s.select);
-      if (ci >= 0) {
+      std::vector<Candidate> all;
+      for (const auto& d : ob.detections) all.push_back({&d, rangeAt(d.bearing)});
+      std::vector<bool> used(all.size(), false);
+      for (size_t n = 0; n < att.size() && status == RunStatus::Running; ++n) {
+        auto& x = att[n];
+        if (!x.attend) continue;
+        // A detection already given to the landmark before (same class) is not this one.
+        std::vector<Candidate> cands;
+        std::vector<size_t> idx;
+        for (size_t c = 0; c < all.size(); ++c)
+          if (!used[c]) cands.push_back(all[c]), idx.push_back(c);
+        const int ci =
+            selectCandidate(cands, x.lm->class_name, x.pred.bearing, x.pred.range, s.select);
+        if (ci < 0) continue;
+        used[idx[ci]] = true;
         const auto& d = *cands[ci].detection;
         const double range = cands[ci].range_m;
-        if (tr->state != LmState::Tracking)
+        LmTrack& t = *x.tr;
+        if (t.state != LmState::Tracking)
           event({{"type", "landmark_seen"},
-                 {"id", lm->id},
-                 {"class", lm->class_name},
-                 {"section", lk},
+                 {"id", x.lm->id},
+                 {"class", x.lm->class_name},
+                 {"section", x.k},
                  {"inliers", d.inliers},
                  {"bearing_deg", d.bearing * 180 / M_PI},
                  {"range_m", range},
-                 {"predicted_bearing_deg", pred.bearing * 180 / M_PI},
-                 {"predicted_range_m", pred.range},
-                 {"candidates", cands.size()}});
-        tr->state = LmState::Tracking;
-        ++tr->frames_seen;
-        tr->max_inliers = std::max(tr->max_inliers, d.inliers);
-        tr->last_seen = now;
-        tr->last_range = range;
-        tr->last_bearing = d.bearing;
-        const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
-        servo_cmd = law.compute(d.x_t, d.x_d, depth);
-        servo_t = now;
-        servo_bearing = d.bearing;
-        if (range > 0 && range <= passDistance(lk, *lm)) passLandmark(lk, li, true);
+                 {"predicted_bearing_deg", x.pred.bearing * 180 / M_PI},
+                 {"predicted_range_m", x.pred.range},
+                 {"candidates", cands.size()},
+                 {"attended_first", n == 0}});
+        t.state = LmState::Tracking;
+        ++t.frames_seen;
+        t.max_inliers = std::max(t.max_inliers, d.inliers);
+        t.last_seen = now;
+        t.last_range = range;
+        t.last_bearing = d.bearing;
+        if (range > 0) {
+          const double b = pose.theta + d.bearing;
+          t.last_fix = {pose.x + range * std::cos(b), pose.y + range * std::sin(b)};
+          t.have_fix = true;
+        }
+        if (n == 0) {
+          const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
+          servo_cmd = law.compute(d.x_t, d.x_d, depth);
+          servo_t = now;
+          servo_bearing = d.bearing;
+          if (range > 0 && range <= passDistance(x.k, *x.lm)) passLandmark(x.k, x.i, true);
+        }
       }
     }
-    if (tr && tr->state == LmState::Tracking && now - tr->last_seen > s.exec.lost_after_s) {
+    for (auto& x : att) {
+      if (status != RunStatus::Running) return;
+      LmTrack& t = *x.tr;
+      if (t.state != LmState::Tracking || now - t.last_seen <= s.exec.lost_after_s) continue;
       // Out of view when already close (it slid out of the side of the image): passed.
-      if (tr->last_range > 0 && tr->last_range <= passDistance(lk, *lm) + 1.0) {
-        passLandmark(lk, li, false);
+      if (t.last_range > 0 && t.last_range <= passDistance(x.k, *x.lm) + 1.0) {
+        passLandmark(x.k, x.i, false);
       } else {
-        tr->state = LmState::Pending;
-        event({{"type", "landmark_lost"}, {"id", lm->id}, {"section", lk}});
+        t.state = LmState::Pending;
+        event({{"type", "landmark_lost"}, {"id", x.lm->id}, {"section", x.k}});
       }
     }
+    if (status != RunStatus::Running) return;
 
     // --- command -------------------------------------------------------------------------
     double v, w, target_bearing;
     std::string mode = "follow", turn = "Straight";
+    bool looking = false;
     const bool servoing =
         tr && tr->state == LmState::Tracking && now - servo_t <= s.exec.servo_hold_s;
     if (servoing) {
@@ -387,24 +473,114 @@ struct Executive::Impl {
     } else {
       const Polar la = polarFrom(pose, tracker.lookahead(pose));
       target_bearing = la.bearing;
-      w = std::clamp(s.exec.k_heading * la.bearing, -s.exec.max_w, s.exec.max_w);
-      v = std::abs(la.bearing) > s.exec.turn_in_place_deg * M_PI / 180
+      // Not seen yet and near: keep it in view (see ExecutiveParams::look_range_m).
+      if (lm && tr->state == LmState::Pending && pred.range <= s.exec.look_range_m &&
+          pred.range > s.exec.approach_m &&
+          std::abs(pred.bearing) <= s.exec.look_max_bearing_deg * M_PI / 180) {
+        const double m = s.exec.look_bearing_deg * M_PI / 180;
+        target_bearing = std::clamp(target_bearing, pred.bearing - m, pred.bearing + m);
+        looking = target_bearing != la.bearing;
+      }
+      w = std::clamp(s.exec.k_heading * target_bearing, -s.exec.max_w, s.exec.max_w);
+      v = std::abs(target_bearing) > s.exec.turn_in_place_deg * M_PI / 180
               ? 0.0
-              : s.exec.v_cruise * std::max(0.2, std::cos(la.bearing));
-      turn = std::abs(la.bearing) < 0.05 ? "Straight" : (la.bearing > 0 ? "Left" : "Right");
+              : s.exec.v_cruise * std::max(0.2, std::cos(target_bearing));
+      turn = std::abs(target_bearing) < 0.05 ? "Straight" : (target_bearing > 0 ? "Left" : "Right");
+      if (looking) mode = "look";
     }
     // Side of the next landmark, for the avoidance's rotation direction.
+    // When the robot is already at the attended landmark, the obstacle is most likely the
+    // furniture it stands on, and dodging round to its side leads away from the route: the
+    // landmark that matters then is the one after it.
+    const mapsketch::ExpectedLandmark* next_lm = lm;
+    if (lm && att.size() > 1 && pred.range <= passDistance(att[0].k, *lm) + 1.0)
+      next_lm = att[1].lm;
     DodgeSide side = DodgeSide::None;
-    if (lm) {
-      if (lm->side == mapsketch::Side::Left) side = DodgeSide::Left;
-      if (lm->side == mapsketch::Side::Right) side = DodgeSide::Right;
-      if (lm->side == mapsketch::Side::Ahead) {
-        const Polar p = polarFrom(pose, tracker.toOdom(lm->position_m));
+    if (next_lm) {
+      if (next_lm->side == mapsketch::Side::Left) side = DodgeSide::Left;
+      if (next_lm->side == mapsketch::Side::Right) side = DodgeSide::Right;
+      if (next_lm->side == mapsketch::Side::Ahead) {
+        const Polar p = polarFrom(pose, tracker.toOdom(next_lm->position_m));
         side = p.bearing >= target_bearing ? DodgeSide::Left : DodgeSide::Right;
       }
     }
+    // Docking: close to the goal with a free straight line to it, drive there directly. The
+    // goal is a place, often near a wall or in a doorway, and the avoider would keep dodging
+    // the wall behind it; the speed is still capped by the clearance ahead.
+    bool docking = false;
+    if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.dock_m && !dev.ranges.empty()) {
+      const Polar pg = polarFrom(pose, tracker.toOdom(sec.end_m));
+      const double free =
+          corridorFree(scanPoints(scans), pg.bearing,
+                       s.avoid.robot_radius_m + s.avoid.corridor_margin_m, s.avoid.max_range_m);
+      if (free >= pg.range) {
+        docking = true;
+        if (avoider.active()) {
+          avoider.reset();
+          event({{"type", "avoid_end"}, {"side", "none"}, {"docking", true}});
+        }
+        target_bearing = pg.bearing;
+        w = std::clamp(s.exec.k_heading * pg.bearing, -s.exec.max_w, s.exec.max_w);
+        v = std::abs(pg.bearing) > s.exec.turn_in_place_deg * M_PI / 180
+                ? 0.0
+                : s.exec.v_cruise * std::max(0.2, std::cos(pg.bearing)) *
+                      std::clamp(pg.range / 0.6, 0.3, 1.0);
+        mode = "dock";
+        turn = std::abs(pg.bearing) < 0.05 ? "Straight" : (pg.bearing > 0 ? "Left" : "Right");
+      }
+    }
+    // Stuck recovery: the reactive layers can livelock (boxed in between furniture, the route
+    // behind an obstacle the dodge went round the wrong way), turning on the spot. Not having
+    // moved stuck_m in stuck_s, the robot drives recover_m towards the most open direction
+    // (ties to the route side), then resumes.
+    if (!recovering && !docking && !dev.ranges.empty() && now - stuck_t >= s.exec.stuck_s) {
+      const bool stuck = std::hypot(pose.x - stuck_ref.x, pose.y - stuck_ref.y) < s.exec.stuck_m;
+      stuck_ref = pose;
+      stuck_t = now;
+      if (stuck) {
+        const auto pts = scanPoints(scans);
+        const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
+        double best = -1e9, best_a = 0;
+        for (int i = 0; i < 36; ++i) {
+          const double a = wrapAngle(i * M_PI / 18);
+          const double free = corridorFree(pts, a, hwid, s.avoid.max_range_m);
+          const double score = std::min(free, s.exec.recover_m + 0.5) -
+                               0.3 * std::abs(wrapAngle(a - target_bearing));
+          if (free >= 0.5 && score > best) best = score, best_a = a;
+        }
+        if (best > -1e9) {
+          recovering = true;
+          ++recoveries;
+          rec_dir = wrapAngle(pose.theta + best_a);
+          rec_t0 = now;
+          rec_from = pose;
+          if (avoider.active()) avoider.reset();
+          event({{"type", "recover_start"}, {"direction_deg", best_a * 180 / M_PI}});
+          log::warn("nav", "stuck: driving clear before resuming",
+                    {{"direction_deg", std::to_string(static_cast<int>(best_a * 180 / M_PI))}});
+        }
+      }
+    }
+    if (recovering) {
+      const double a = wrapAngle(rec_dir - pose.theta);
+      w = std::clamp(s.avoid.k_heading * a, -s.exec.max_w, s.exec.max_w);
+      v = std::abs(a) > 0.35 ? 0.0 : avoider.capSpeed(scans, 0.7 * s.exec.v_cruise);
+      mode = "recover";
+      turn = std::abs(w) < 0.05 ? "Straight" : (w > 0 ? "Left" : "Right");
+      const bool blocked = std::abs(a) <= 0.35 && v <= 0;
+      if (std::hypot(pose.x - rec_from.x, pose.y - rec_from.y) >= s.exec.recover_m ||
+          now - rec_t0 > s.exec.recover_s || blocked) {
+        recovering = false;
+        stuck_ref = pose;
+        stuck_t = now;
+        event({{"type", "recover_end"}});
+      }
+    }
     double front = 0;
-    if (!dev.ranges.empty()) {
+    if (docking || recovering) {
+      if (docking) v = avoider.capSpeed(scans, v);
+    } else if (!dev.ranges.empty()) {
+      avoider.setPose(pose);
       const auto av = avoider.step(scans, target_bearing, side, pose.theta, s.exec.v_cruise, now);
       front = av.front_free_m;
       if (av.started) {
@@ -428,11 +604,36 @@ struct Executive::Impl {
     // An end point that cannot be reached (the sketch put it in or against an obstacle): when
     // the robot is dodging within end_blocked_m of it, the section is done.
     bool end_blocked = false;
-    if (mode == "avoid" && prog.to_end_m <= s.exec.end_blocked_m && !sectionBlocked_) {
+    // The goal counts as blocked only when the robot cannot get within 0.6 m of it.
+    const double blocked_m =
+        k + 1 == tracker.count() ? std::min(0.6, s.exec.end_blocked_m) : s.exec.end_blocked_m;
+    if (mode == "avoid" && prog.to_end_m <= blocked_m && !sectionBlocked_) {
       // Blocked means the range sensors see something at or before the end point itself.
       const Polar pe = polarFrom(pose, tracker.toOdom(sec.end_m));
       const double r = rangeAt(pe.bearing);
-      end_blocked = r > 0 && r < pe.range + s.avoid.robot_radius_m + 0.1;
+      // For the goal, only an obstacle the robot could not stand next to the point for: a goal
+      // half a metre from a wall is reachable and must be reached.
+      const bool last = k + 1 == tracker.count();
+      end_blocked = r > 0 && r < pe.range + s.avoid.robot_radius_m + (last ? -0.05 : 0.1);
+    }
+    // Near the goal but no longer getting closer (the estimate sits where the robot cannot
+    // stand, e.g. against a door frame): the best it can do is where it is.
+    bool goal_settled = false;
+    if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.goal_settle_m) {
+      if (prog.to_end_m < goal_best_ - 0.05) goal_best_ = prog.to_end_m, goal_best_t_ = now;
+      goal_settled = now - goal_best_t_ > s.exec.goal_settle_s;
+    } else {
+      goal_best_ = 1e300;
+      goal_best_t_ = now;
+    }
+    if (goal_settled) {
+      event({{"type", "goal_settled"}, {"to_end_m", prog.to_end_m}});
+      tracker.advance();
+      closeSections(k);
+      if (status != RunStatus::Running) return;
+      finish(RunStatus::Succeeded, "reached the end of the route (could not get closer than " +
+                                       std::to_string(prog.to_end_m).substr(0, 4) + " m)");
+      return;
     }
     if (end_blocked) {
       sectionBlocked_ = true;
@@ -479,22 +680,55 @@ struct Executive::Impl {
     auto& tr = tracks[k][i];
     const auto& lm = tracker.route().sections[k].landmarks[i];
     tr.state = LmState::Passed;
+    // Passed out of order (the one after the attended landmark was seen first): every earlier
+    // landmark still pending is behind the robot now.
+    for (int kk = 0; kk <= k; ++kk)
+      for (int ii = 0; ii < (kk < k ? static_cast<int>(tracks[kk].size()) : i); ++ii)
+        if (tracks[kk][ii].state == LmState::Pending) {
+          if (tracks[kk][ii].frames_seen > 0)
+            tracks[kk][ii].state = LmState::Passed;
+          else
+            markMissed(kk, ii, false);
+        }
     missed_in_row = 0;
     json e = {{"type", "landmark_passed"}, {"id", lm.id},
               {"class", lm.class_name},    {"section", k},
-              {"range_m", tr.last_range},  {"frames_seen", tr.frames_seen}};
-    if (seen_close) {
-      // Where the landmark really is (odometry frame) vs where the sketch puts it: rotate the
-      // route about the last trusted fix, then shift it, each by its gain.
-      const double b = pose.theta + tr.last_bearing;
-      const Eigen::Vector2d seen(pose.x + tr.last_range * std::cos(b),
-                                 pose.y + tr.last_range * std::sin(b));
-      const double rot = tracker.realign(lm.position_m, seen, fix_route, fix_odom,
-                                         s.exec.realign_gain, s.exec.realign_baseline_m);
+              {"range_m", tr.last_range},  {"frames_seen", tr.frames_seen},
+              {"in_view", seen_close}};
+    // Far sightings are left out: the laser range along their bearing may be something else.
+    if (tr.have_fix && tr.last_range <= s.exec.max_approach_m + 1.5) {
+      // Where the landmark really is (odometry frame, from its last ranged sighting) vs where
+      // the sketch puts it: rotate the route about the last trusted fix, then shift it, each by
+      // its gain. A landmark that slid out of view when close was seen as well as one passed
+      // in view, and the last landmark before the goal is often passed that way.
+      const Eigen::Vector2d seen = tr.last_fix;
       const Eigen::Vector2d shift = seen - tracker.toOdom(lm.position_m);
-      tracker.reanchor(lm.position_m, seen, s.exec.reanchor_gain);
-      e["realign_deg"] = rot * 180 / M_PI;
-      e["reanchor_m"] = shift.norm() * s.exec.reanchor_gain;
+      fixes_route.push_back(lm.position_m);
+      fixes_odom.push_back(seen);
+      // With enough fixes spread far enough: refit rotation, scale and translation to the
+      // last fit_fixes of them (the start counts as one) by least squares, then pull the route
+      // part of the way to this one (hand-drawn maps are also locally distorted).
+      const size_t n = std::min<size_t>(fixes_route.size(), std::max(0, s.exec.fit_fixes));
+      std::vector<Eigen::Vector2d> fr(fixes_route.end() - n, fixes_route.end()),
+          fo(fixes_odom.end() - n, fixes_odom.end());
+      double span = 0;
+      for (const auto& a : fr)
+        for (const auto& b : fr) span = std::max(span, (a - b).norm());
+      if (n >= 3 && span >= s.exec.fit_min_span_m) {
+        const auto f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change);
+        tracker.reanchor(lm.position_m, seen, s.exec.fit_local_gain);
+        e["fit_rotation_deg"] = f.rotation * 180 / M_PI;
+        e["fit_scale"] = tracker.scale();
+        e["fit_rms_m"] = f.rms;
+        e["fit_fixes"] = n;
+      } else {
+        const double rot = tracker.realign(lm.position_m, seen, fix_route, fix_odom,
+                                           s.exec.realign_gain, s.exec.realign_baseline_m);
+        tracker.reanchor(lm.position_m, seen, s.exec.reanchor_gain);
+        e["realign_deg"] = rot * 180 / M_PI;
+        e["reanchor_m"] = shift.norm() * s.exec.reanchor_gain;
+      }
+      e["disagreement_m"] = shift.norm();
       fix_route = lm.position_m;
       fix_odom = seen;
     }
@@ -506,13 +740,19 @@ struct Executive::Impl {
     for (int k = from; k < tracker.current() && status == RunStatus::Running; ++k) {
       for (size_t i = 0; i < tracks[k].size(); ++i) {
         auto& tr = tracks[k][i];
-        if (tr.state == LmState::Tracking)
+        if (tr.state == LmState::Tracking || (tr.state == LmState::Pending && tr.frames_seen > 0))
           passLandmark(k, static_cast<int>(i), false);
         else if (tr.state == LmState::Pending)
           markMissed(k, static_cast<int>(i));
         if (status != RunStatus::Running) return;
       }
-      event({{"type", "section_done"}, {"section", k}, {"of", tracker.count()}});
+      // Where the (re-anchored) route put the end point, and the robot: for judging the sketch.
+      const Eigen::Vector2d end = tracker.toOdom(tracker.route().sections[k].end_m);
+      event({{"type", "section_done"},
+             {"section", k},
+             {"of", tracker.count()},
+             {"end_odom", {end.x(), end.y()}},
+             {"pose_odom", {pose.x, pose.y, pose.theta}}});
       log::info("nav", "section " + std::to_string(k + 1) + "/" + std::to_string(tracker.count()) +
                            " done");
     }
@@ -533,8 +773,11 @@ void Executive::start() {
   I.t0 = I.now = I.dev.clock->now();
   I.next_tick = I.t0;
   I.section_t0 = I.t0;
+  I.stuck_t = I.t0;
   I.fix_route = I.tracker.route().start_m;
   I.fix_odom = I.tracker.toOdom(I.fix_route);
+  I.fixes_route = {I.fix_route};
+  I.fixes_odom = {I.fix_odom};
   I.safety.start(I.t0);
   I.status = RunStatus::Running;
   I.event({{"type", "start"},
@@ -607,6 +850,8 @@ ExecutiveSummary Executive::summary() const {
   }
   s.perception_ms_max = I.perc_max;
   s.avoidance_manoeuvres = I.manoeuvres;
+  s.recoveries = I.recoveries;
+  s.laser_odometry = I.lodo.stats();
   return s;
 }
 

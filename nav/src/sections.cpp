@@ -18,6 +18,8 @@ void SectionParams::validate() const {
   require(reach_radius_m > 0 && reach_radius_m < 5, "nav.sections.reach_radius_m",
           "must be in (0, 5) m");
   require(end_slack_m >= 0 && end_slack_m < 5, "nav.sections.end_slack_m", "must be in [0, 5) m");
+  require(goal_radius_m > 0 && goal_radius_m <= 5, "nav.sections.goal_radius_m",
+          "must be in (0, 5] m");
   require(lookahead_m > 0.1 && lookahead_m < 10, "nav.sections.lookahead_m",
           "must be in (0.1, 10) m");
 }
@@ -42,10 +44,10 @@ const mapsketch::PathSection& SectionTracker::section() const {
 }
 
 Eigen::Vector2d SectionTracker::toOdom(const Eigen::Vector2d& p) const {
-  return rot(rot_, p - route_.start_m) + trans_;
+  return scale_ * rot(rot_, p - route_.start_m) + trans_;
 }
 Eigen::Vector2d SectionTracker::toRoute(const Eigen::Vector2d& p) const {
-  return rot(-rot_, p - trans_) + route_.start_m;
+  return rot(-rot_, p - trans_) / scale_ + route_.start_m;
 }
 double SectionTracker::headingToOdom(double h) const {
   return wrapAngle(h + rot_);
@@ -67,8 +69,40 @@ double SectionTracker::realign(const Eigen::Vector2d& route_pt, const Eigen::Vec
       gain * wrapAngle(std::atan2(seen.y(), seen.x()) - std::atan2(predicted.y(), predicted.x()));
   // Rotate about the anchor: it must map to anchor_odom before and after.
   rot_ += delta;
-  trans_ = anchor_odom - rot(rot_, anchor_route - route_.start_m);
+  trans_ = anchor_odom - scale_ * rot(rot_, anchor_route - route_.start_m);
   return delta;
+}
+
+SectionTracker::Fit SectionTracker::fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
+                                                  const std::vector<Eigen::Vector2d>& odom_pts,
+                                                  double max_scale_change) {
+  Fit f;
+  const size_t n = std::min(route_pts.size(), odom_pts.size());
+  if (n < 2) return f;
+  // Least-squares similarity (Umeyama in 2-D, complex form): odom = s R route + t.
+  Eigen::Vector2d mr(0, 0), mo(0, 0);
+  for (size_t i = 0; i < n; ++i) mr += route_pts[i], mo += odom_pts[i];
+  mr /= n, mo /= n;
+  double a = 0, b = 0, vr = 0;
+  for (size_t i = 0; i < n; ++i) {
+    const Eigen::Vector2d r = route_pts[i] - mr, o = odom_pts[i] - mo;
+    a += r.x() * o.x() + r.y() * o.y();
+    b += r.x() * o.y() - r.y() * o.x();
+    vr += r.squaredNorm();
+  }
+  if (vr < 1e-9) return f;
+  const double theta = std::atan2(b, a);
+  const double sc = std::clamp(std::hypot(a, b) / vr, scale_ * (1 - max_scale_change),
+                               scale_ * (1 + max_scale_change));
+  f.rotation = wrapAngle(theta - rot_);
+  f.scale = sc / scale_;
+  rot_ = theta;
+  scale_ = sc;
+  trans_ = mo - scale_ * rot(rot_, mr - route_.start_m);
+  for (size_t i = 0; i < n; ++i) f.rms += (toOdom(route_pts[i]) - odom_pts[i]).squaredNorm();
+  f.rms = std::sqrt(f.rms / n);
+  f.ok = true;
+  return f;
 }
 
 SectionProgress SectionTracker::progress(const hw::Pose2D& o) const {
@@ -92,7 +126,12 @@ int SectionTracker::update(const hw::Pose2D& o) {
     const auto p = progress(o);
     // Reached its end point, or crossed the line through the end point (perpendicular to the
     // section): a robot pushed sideways by a dodge must not circle back to the exact point.
-    if (p.to_end_m > params_.reach_radius_m && p.remaining_m > params_.end_slack_m) break;
+    // The last section ends at the goal, which is a place, not a line: crossing the line there
+    // does not count (an overshoot turns back to the goal point).
+    const bool last = current_ + 1 == count();
+    const double reach = last ? params_.goal_radius_m : params_.reach_radius_m;
+    const bool crossed = !last && p.remaining_m <= params_.end_slack_m;
+    if (p.to_end_m > reach && !crossed) break;
     ++current_;
     ++n;
   }

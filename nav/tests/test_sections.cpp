@@ -37,7 +37,11 @@ TEST(SectionTracker, ProgressAndAdvance) {
   EXPECT_EQ(t.update({3.8, 0.1, 0}), 1);  // within the reach radius of (4, 0)
   EXPECT_EQ(t.current(), 1);
   EXPECT_EQ(t.update({4.1, 1.0, 1.57}), 0);
-  EXPECT_EQ(t.update({4.0, 3.4, 1.57}), 1);  // overshot the end: past it counts
+  // The last section ends at the goal, a place: overshooting its line does not count (the
+  // robot turns back), being within goal_radius_m of it does.
+  EXPECT_EQ(t.update({4.0, 3.4, 1.57}), 0);
+  EXPECT_EQ(t.update({4.4, 3.0, 1.57}), 0);
+  EXPECT_EQ(t.update({4.05, 3.1, -1.57}), 1);
   EXPECT_TRUE(t.finished());
   SectionTracker t2(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
   EXPECT_EQ(t2.update({3.95, 1.2, 0}), 1);  // 1.2 m off to the side but across the end line

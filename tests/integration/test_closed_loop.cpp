@@ -138,3 +138,25 @@ TEST(ClosedLoop, StopsOnADroppedCamera) {
   EXPECT_GE(s["time_s"].get<double>(), 6.0);
   EXPECT_EQ(countEvents(o.out_dir, "fault"), 1);
 }
+
+// The product's main job as `sketchnav run` does it with no options: the built-in lab (two
+// rooms, eight landmarks, the hand-drawn lab sketch). Seed 1 as the command's default; the
+// seed sweep is in the closing notes / `sketchnav experiments`, not here.
+TEST(ClosedLoop, LabRunReachesTheGoal) {
+  RunOptions o;
+  o.world = "lab";
+  o.seed = 1;
+  o.cache_dir = SKETCHNAV_MODEL_CACHE_DIR;
+  o.out_dir = test::tempDir("nav-lab");
+  o.progress = false;
+  const Json s = app::runNavigation(o);
+  EXPECT_TRUE(s["success"].get<bool>()) << s["reason"];
+  EXPECT_TRUE(s["at_goal"].get<bool>());
+  EXPECT_FALSE(s["collided"].get<bool>());
+  EXPECT_GT(s["min_clearance_m"].get<double>(), 0.1);
+  // Most of the eight landmarks recognised, in both rooms.
+  EXPECT_GE(s["landmarks_recognised"].size(), 6u);
+  EXPECT_TRUE(recognised(s, "L1"));
+  EXPECT_TRUE(recognised(s, "L8"));
+  EXPECT_EQ(countEvents(o.out_dir, "section_done"), 6);
+}

@@ -1,8 +1,8 @@
 #pragma once
-// The landmark model (.slm): vocabulary, BoW classifier and, per class, the keypoints and
-// descriptors of its database photos for matching. Built by trainModel() from a landmark set
-// folder; saved as a versioned binary file (magic, format version, payload size, FNV-1a
-// checksum) so a truncated file or a file of another version is refused with a clear error.
+// The landmark model (.slm): vocabulary, BoW classifier and, per class, the keypoints,
+// descriptors and keypoint colours of its database photos for matching. Built by trainModel() from
+// a landmark set folder; saved as a versioned binary file (magic, format version, payload size,
+// FNV-1a checksum) so a truncated file or a file of another version is refused with a clear error.
 #include <opencv2/core.hpp>
 
 #include <functional>
@@ -18,9 +18,14 @@ namespace sketchnav::landmarks {
 
 /// Training settings ("landmarks.train.*").
 struct ModelParams {
-  FeatureParams features;
-  int vocabulary_size = 1000;  // visual words; capped at training descriptors / 10
-  int kmeans_sample = 60000;   // descriptors sampled for k-means
+  FeatureParams features;  // database photos
+  // Camera frames / query images (computeFrameFeatures(model, image)): fewer keypoints than the
+  // database photos, because SIFT and the per-keypoint searches are the per-frame cost while
+  // database keypoints are paid once, at training time.
+  int frame_max_features = 500;    // keypoints kept per frame (strongest); 0 = all
+  int frame_max_image_side = 400;  // [px] longer frame side above this is downscaled for SIFT
+  int vocabulary_size = 1000;      // visual words; capped at training descriptors / 10
+  int kmeans_sample = 60000;       // descriptors sampled for k-means
   int kmeans_iterations = 8;
   double svm_c = 1.0;  // linear SVM soft-margin constant
   int seed = 1;        // descriptor sampling, k-means seeding, CV folds
@@ -31,6 +36,8 @@ struct ModelParams {
     b("max_image_side", features.max_image_side);
     b("contrast_threshold", features.contrast_threshold);
     b("root_sift", features.root_sift);
+    b("frame_max_features", frame_max_features);
+    b("frame_max_image_side", frame_max_image_side);
     b("vocabulary_size", vocabulary_size);
     b("kmeans_sample", kmeans_sample);
     b("kmeans_iterations", kmeans_iterations);
@@ -38,6 +45,13 @@ struct ModelParams {
     b("seed", seed);
   }
   void validate() const;
+  /// The feature settings for frames: `features` with the frame_* limits.
+  FeatureParams frameFeatures() const {
+    FeatureParams f = features;
+    f.max_features = frame_max_features;
+    f.max_image_side = frame_max_image_side;
+    return f;
+  }
 };
 
 /// One database photo: its features for matching and its BoW histogram for the shortlist.
@@ -47,6 +61,7 @@ struct DatabasePhoto {
   cv::Size size;     // photo size in pixels (keypoints are in these pixels)
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat sift_u8;      // N x 128 CV_8U raw SIFT (stored form)
+  cv::Mat colours;      // N x 3 CV_8U colour around each keypoint (keypointColours())
   cv::Mat descriptors;  // N x 128 CV_32F working descriptors (RootSIFT or SIFT), built on load
   std::vector<int> words;
   cv::Mat histogram;  // 1 x K BoW histogram, built on load
@@ -54,7 +69,9 @@ struct DatabasePhoto {
 
 class LandmarkModel {
  public:
-  static constexpr std::uint32_t kFormatVersion = 1;
+  // 3: keypoint colours (opponent chromaticity) and frame_* params; 2 was a development format
+  // with another colour definition, refused so no model of it is used by mistake.
+  static constexpr std::uint32_t kFormatVersion = 3;
 
   LandmarkModel();
   ~LandmarkModel();
@@ -80,9 +97,17 @@ class LandmarkModel {
   /// globalOwner() maps them to (photo, keypoint).
   void knnAll(const cv::Mat& query, int k, int checks, cv::Mat& indices, cv::Mat& dists) const;
   std::pair<int, int> globalOwner(int row) const;
-  /// Builds the database-wide search index now instead of on first use (seconds for 864
-  /// photos, a fraction of a second for 72), so the first camera frame is not slow.
-  /// Idempotent; thread-safe.
+  /// Per database photo (indexed like photos(); 0 outside the class): how many `query` rows
+  /// have their nearest descriptor among the class's photos in that photo (one approximate
+  /// search in a per-class kd-tree, built lazily and cached; thread-safe). Orders a class's
+  /// photos for matching: a camera frame's BoW histogram is mostly background.
+  std::vector<int> classPhotoVotes(int class_id, const cv::Mat& query, int checks) const;
+  /// The same search: per query row, the photo (index into photos()) holding its nearest
+  /// descriptor among the class's photos, -1 when none.
+  std::vector<int> classNearestPhoto(int class_id, const cv::Mat& query, int checks) const;
+  /// Builds the database-wide and per-class search indexes now instead of on first use (seconds for
+  /// 864 photos, a fraction of a second for 72), so the first camera frame is not slow. Idempotent;
+  /// thread-safe.
   void buildIndexes() const;
 
   /// Writes the .slm file; throws RuntimeError when it cannot be written.

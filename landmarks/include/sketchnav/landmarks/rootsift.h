@@ -36,6 +36,7 @@ struct FeatureParams {
 struct Features {
   std::vector<cv::KeyPoint> keypoints;
   cv::Mat descriptors;  // N x 128 CV_32F: RootSIFT or SIFT per FeatureParams::root_sift
+  cv::Mat colours;      // N x 3 CV_8U keypointColours(); empty for a grey image
   cv::Size image_size;
 };
 
@@ -53,7 +54,23 @@ void detectSift(const cv::Mat& image, const FeatureParams& p, std::vector<cv::Ke
 /// Converts stored CV_8U SIFT to the working descriptor (RootSIFT or SIFT as CV_32F).
 cv::Mat workingDescriptors(const cv::Mat& sift_u8, bool root_sift);
 
-/// detectSift + workingDescriptors.
+/// Mean colour around each keypoint (a square of the keypoint's size, at least a few pixels),
+/// N x 3 CV_8U: intensity (0..255), then two opponent chromaticities divided by the intensity
+/// (red−green and yellow−blue, 128 = neutral, ~100 units for the full range), so the chroma
+/// does not change when the same surface is lit more or less brightly. SIFT sees only grey
+/// levels, so sibling products (the same artwork printed on an orange or a green carton) give
+/// the same descriptors; the colour around a matched keypoint tells them apart
+/// (chromaDistance2()). Empty for a grey (1-channel) image: no colour evidence, colour checks
+/// are skipped.
+cv::Mat keypointColours(const cv::Mat& image, const std::vector<cv::KeyPoint>& keypoints);
+
+/// Squared chroma distance (intensity ignored) between rows of two keypointColours() matrices.
+inline float chromaDistance2(const unsigned char* a, const unsigned char* b) {
+  const float da = static_cast<float>(a[1]) - b[1], db = static_cast<float>(a[2]) - b[2];
+  return da * da + db * db;
+}
+
+/// detectSift + workingDescriptors + keypointColours.
 Features extractFeatures(const cv::Mat& image, const FeatureParams& p);
 
 }  // namespace sketchnav::landmarks

@@ -9,6 +9,8 @@
 // walking the way the robot dodges means several manoeuvres) until the corridor towards the
 // route is clear again. A minimum clearance is never given up on purpose: when anything is
 // closer than `min_clearance_m` in the direction of motion the forward speed is zero.
+#include <Eigen/Core>
+
 #include <memory>
 #include <string>
 #include <vector>
@@ -21,20 +23,25 @@ enum class DodgeSide { None, Left, Right };
 const char* toString(DodgeSide s);
 
 struct AvoidParams {
-  double robot_radius_m = 0.20;     // [m] body radius (the diagram is in configuration space)
-  double trigger_m = 0.9;           // [m] free corridor length ahead below which avoidance starts
-  double release_m = 1.4;           // [m] corridor towards the route this free -> avoidance ends
-  double corridor_margin_m = 0.12;  // [m] added to the radius for the corridor checks
-  double min_clearance_m = 0.12;    // [m] never move forward closer than this to anything
-  double slow_m = 0.8;              // [m] forward speed scales down below this clearance ahead
-  double max_range_m = 3.0;         // [m] obstacles beyond this are ignored (ND normalisation)
-  double side_bias_deg = 35;        // [deg] target rotation towards the chosen side while dodging
-  double min_active_s = 1.0;        // [s] hold a manoeuvre at least this long (no chattering)
-  double k_heading = 1.5;           // [1/s] yaw rate per rad of direction error
-  double approach_horizon_s = 3.0;  // [s] an obstacle coming towards the robot (a pedestrian)
-                                    // triggers this much earlier (its speed x horizon)
-  double reverse_speed = 0.12;      // [m/s] back-off speed when something keeps coming closer
-  int sectors = 144;                // polar diagram resolution over 360 deg
+  double robot_radius_m = 0.20;      // [m] body radius (the diagram is in configuration space)
+  double trigger_m = 0.9;            // [m] free corridor length ahead below which avoidance starts
+  double release_m = 1.4;            // [m] corridor towards the route this free -> avoidance ends
+  double corridor_margin_m = 0.12;   // [m] added to the radius for the corridor checks
+  double min_clearance_m = 0.12;     // [m] never move forward closer than this to anything
+  double slow_m = 0.8;               // [m] forward speed scales down below this clearance ahead
+  double max_range_m = 3.0;          // [m] obstacles beyond this are ignored (ND normalisation)
+  double side_bias_deg = 35;         // [deg] target rotation towards the chosen side while dodging
+  double moving_side_bias_deg = 65;  // [deg] the same for an obstacle coming towards the robot:
+                                     // a pedestrian closes at ~0.7 m/s, so step out of its
+                                     // lane rather than edge round it
+  double min_active_s = 1.0;         // [s] hold a manoeuvre at least this long (no chattering)
+  double same_side_s = 3.0;          // [s] a manoeuvre starting this soon after the last one
+                                     // ended dodges to the same side
+  double k_heading = 1.5;            // [1/s] yaw rate per rad of direction error
+  double approach_horizon_s = 3.0;   // [s] an obstacle coming towards the robot (a pedestrian)
+                                     // triggers this much earlier (its speed x horizon)
+  double reverse_speed = 0.12;       // [m/s] back-off speed when something keeps coming closer
+  int sectors = 144;                 // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
     b("robot_radius_m", robot_radius_m);
@@ -45,7 +52,9 @@ struct AvoidParams {
     b("slow_m", slow_m);
     b("max_range_m", max_range_m);
     b("side_bias_deg", side_bias_deg);
+    b("moving_side_bias_deg", moving_side_bias_deg);
     b("min_active_s", min_active_s);
+    b("same_side_s", same_side_s);
     b("k_heading", k_heading);
     b("approach_horizon_s", approach_horizon_s);
     b("reverse_speed", reverse_speed);
@@ -94,6 +103,13 @@ class ObstacleAvoider {
   /// Returns the capped forward speed.
   double capSpeed(const std::vector<hw::RangeScan>& scans, double v) const;
 
+  /// The robot's odometry pose for the next step(): obstacle motion (a pedestrian coming
+  /// towards the robot) is then judged in the odometry frame, also while turning. Without it,
+  /// only from the free corridor ahead shrinking faster than the robot drives, while straight.
+  void setPose(const hw::Pose2D& pose) {
+    pose_ = pose;
+    have_pose_ = true;
+  }
   bool active() const { return active_; }
   void reset();
   const AvoidParams& params() const { return params_; }
@@ -111,6 +127,13 @@ class ObstacleAvoider {
   double prev_stamp_ = -1e300;
   double approach_ = 0;  // [m/s] filtered speed of the obstacle ahead towards the robot
   bool have_prev_ = false;
+  DodgeSide last_side_ = DodgeSide::None;  // side of the last manoeuvre, and when it ended
+  double last_end_t_ = -1e300;
+  hw::Pose2D pose_;
+  bool have_pose_ = false;
+  Eigen::Vector2d prev_pt_{0, 0};  // nearest obstacle point ahead at the last scan (odometry)
+  double prev_pt_t_ = 0;
+  bool have_prev_pt_ = false;
 };
 
 }  // namespace sketchnav::nav

@@ -20,6 +20,7 @@
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/avoidance.h"
 #include "sketchnav/nav/landmark_stage.h"
+#include "sketchnav/nav/laser_odometry.h"
 #include "sketchnav/nav/perception.h"
 #include "sketchnav/nav/safety.h"
 #include "sketchnav/nav/sections.h"
@@ -47,13 +48,39 @@ struct ExecutiveParams {
   double reanchor_gain = 0.8;   // how much a passed landmark re-anchors the route (0 = never)
   double end_blocked_m = 1.0;   // [m] dodging this close to a section's end point, with an
                                 // obstacle at or before it, ends the section
-  double realign_gain = 0.8;    // how much it re-rotates the route about the previous fix
-  double realign_baseline_m = 2.0;   // [m] minimum fix-to-landmark distance for that
+  // Once fixes (the start and passed landmarks) span fit_min_span_m, the route's rotation,
+  // scale and position are refitted by least squares to the last fit_fixes of them
+  // (SectionTracker::fitSimilarity), then shifted fit_local_gain of the way to the newest;
+  // before that, realign/reanchor below. 0 fixes = always realign/reanchor.
+  int fit_fixes = 4;
+  double fit_min_span_m = 5.0;         // [m]
+  double fit_max_scale_change = 0.15;  // relative, per fit
+  double fit_local_gain = 0.3;
+  double realign_gain = 0.8;         // how much it re-rotates the route about the previous fix
+  double realign_baseline_m = 5.0;   // [m] minimum fix-to-landmark distance for that: a
+                                     // sighting is good to ~0.3 m, so a shorter baseline
+                                     // turns the route by more than it corrects
   double perception_period_s = 0.2;  // [s] frames given to perception at most this often
   double attend_bearing_deg = 75;    // [deg] look for the landmark only when the sketch puts it
   double attend_range_m = 12;        // [m]  within this bearing and range
   int max_missed_in_row = 2;         // more consecutive missed landmarks than this: lost, fail
+  // Looking for a landmark: the camera sees +-30 deg and a 0.4 m sign is recognised out to
+  // ~3 m, so a landmark sketched beside the path is only in view for a moment. While one is
+  // expected within look_range_m and not yet seen, the heading is kept within look_bearing_deg
+  // of where the sketch puts it (the robot turns towards it, as the paper's robot does).
+  // It never turns back for one: beyond look_max_bearing_deg the landmark is left to the
+  // miss test (a robot turning round for a landmark behind it livelocks against obstacles).
+  double look_range_m = 5.0;         // [m]
+  double look_bearing_deg = 10;      // [deg]
+  double look_max_bearing_deg = 60;  // [deg]
   double goal_stop_s = 0.5;          // [s] settle time at the goal
+  double dock_m = 1.5;  // [m] this close to the goal, with a free line to it, drive straight there
+  double goal_settle_m = 1.0;  // [m] within this of the goal, not 5 cm closer for
+  double goal_settle_s = 8;    // [s] this long: arrived as close as it can get
+  double stuck_s = 10;         // [s] not having moved stuck_m in this long (not docking): stuck
+  double stuck_m = 0.3;        // [m]
+  double recover_m = 1.0;      // [m] then drive this far towards the most open direction
+  double recover_s = 8;        // [s] (at most this long) and resume
   template <class B>
   void bind(B& b) {
     b("tick_s", tick_s);
@@ -72,13 +99,27 @@ struct ExecutiveParams {
     b("miss_slack_m", miss_slack_m);
     b("reanchor_gain", reanchor_gain);
     b("end_blocked_m", end_blocked_m);
+    b("fit_fixes", fit_fixes);
+    b("fit_min_span_m", fit_min_span_m);
+    b("fit_max_scale_change", fit_max_scale_change);
+    b("fit_local_gain", fit_local_gain);
     b("realign_gain", realign_gain);
     b("realign_baseline_m", realign_baseline_m);
     b("perception_period_s", perception_period_s);
     b("attend_bearing_deg", attend_bearing_deg);
     b("attend_range_m", attend_range_m);
     b("max_missed_in_row", max_missed_in_row);
+    b("look_range_m", look_range_m);
+    b("look_bearing_deg", look_bearing_deg);
+    b("look_max_bearing_deg", look_max_bearing_deg);
     b("goal_stop_s", goal_stop_s);
+    b("dock_m", dock_m);
+    b("goal_settle_m", goal_settle_m);
+    b("goal_settle_s", goal_settle_s);
+    b("stuck_s", stuck_s);
+    b("stuck_m", stuck_m);
+    b("recover_m", recover_m);
+    b("recover_s", recover_s);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };
@@ -90,11 +131,13 @@ struct NavSettings {
   SelectParams select;
   AvoidParams avoid;
   SafetyParams safety;
+  LaserOdometryParams laser_odometry;
   servo::TurnLawParams servo;
 };
 
 /// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*",
-/// "nav.avoid.*", "nav.safety.*", "servo.*") over the defaults and validates.
+/// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "servo.*") over the defaults and
+/// validates.
 NavSettings navSettingsFrom(const Config& config);
 
 /// One control tick, for telemetry.csv.
@@ -103,8 +146,8 @@ struct TelemetryRow {
   hw::Pose2D odom;
   double v_cmd = 0, w_cmd = 0;
   double servo_error = 0;  // x_t - x_d when servoing, NaN otherwise
-  std::string mode;        // follow | servo | avoid | stopped | done | failed
-  std::string turn;        // Left | Straight | Right
+  std::string mode;  // follow | look | servo | dock | recover | avoid | stopped | done | failed
+  std::string turn;  // Left | Straight | Right
   int section = 0;
   std::string landmark;     // id of the attended landmark ("" when none)
   double front_free_m = 0;  // free corridor ahead
@@ -139,6 +182,8 @@ struct ExecutiveSummary {
   double perception_ms_mean = 0, perception_ms_max = 0;
   double objectness_ms_mean = 0, features_ms_mean = 0, match_ms_mean = 0;
   int avoidance_manoeuvres = 0;
+  int recoveries = 0;  // stuck recoveries
+  LaserOdometryStats laser_odometry;
   nlohmann::json toJson() const;
 };
 

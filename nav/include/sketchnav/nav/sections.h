@@ -22,11 +22,15 @@ struct SectionParams {
   double reach_radius_m = 0.35;  // [m] a section ends when its end point is this close...
   double end_slack_m = 0.10;     // [m] ...or the robot has crossed the line through its end
                                  // point (perpendicular to it) to within this
+  double goal_radius_m = 0.15;   // [m] the last section (the goal) ends only this close to its
+                                 // end point (docking drives straight there, so it is reached;
+                                 // every cm here is one less for the sketch's own error)
   double lookahead_m = 1.0;      // [m] pure-pursuit look-ahead along the remaining route
   template <class B>
   void bind(B& b) {
     b("reach_radius_m", reach_radius_m);
     b("end_slack_m", end_slack_m);
+    b("goal_radius_m", goal_radius_m);
     b("lookahead_m", lookahead_m);
   }
   void validate() const;  // InputError "nav.sections.<field> = ...: ..."
@@ -65,6 +69,22 @@ class SectionTracker {
                  const Eigen::Vector2d& anchor_route, const Eigen::Vector2d& anchor_odom,
                  double gain, double min_baseline_m = 1.5);
 
+  /// Refits the whole alignment (rotation, scale, translation) to trusted fixes by least
+  /// squares: `route_pts[i]` (sketch) was seen at `odom_pts[i]`. A hand-drawn map's scale comes
+  /// from the user's distance guesses (10-25 % off each); several fixes a few metres apart pin
+  /// scale and heading down far better, and the error of each sketched position averages out
+  /// instead of being copied by a shift. The scale moves at most `max_scale_change` (relative)
+  /// per fit. Needs two or more fixes.
+  struct Fit {
+    bool ok = false;
+    double rotation = 0;  // [rad] change
+    double scale = 1;     // relative change
+    double rms = 0;       // [m] residual over the fixes
+  };
+  Fit fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
+                    const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15);
+  double scale() const { return scale_; }
+
   SectionProgress progress(const hw::Pose2D& odom) const;
   /// Advances past every section whose end has been reached; returns how many it advanced.
   int update(const hw::Pose2D& odom);
@@ -81,7 +101,8 @@ class SectionTracker {
   SectionParams params_;
   int current_ = 0;
   double rot_ = 0;               // odom heading = route heading + rot_
-  Eigen::Vector2d trans_{0, 0};  // odom = R(rot_) (route - start) + trans_
+  double scale_ = 1;             // odom metres per route metre
+  Eigen::Vector2d trans_{0, 0};  // odom = scale_ R(rot_) (route - start) + trans_
 };
 
 /// Bearing [rad, CCW, robot frame] and range [m] of an odometry-frame point from a pose.

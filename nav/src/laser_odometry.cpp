@@ -1,0 +1,201 @@
+#include "sketchnav/nav/laser_odometry.h"
+
+#include <mrpt/maps/CSimplePointsMap.h>
+#include <mrpt/poses/CPose2D.h>
+#include <mrpt/poses/CPosePDF.h>
+#include <mrpt/slam/CICP.h>
+
+#include <chrono>
+#include <cmath>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/nav/sections.h"
+
+namespace sketchnav::nav {
+
+using mrpt::poses::CPose2D;
+
+void LaserOdometryParams::validate() const {
+  require(keyframe_dist_m > 0, "nav.laser_odometry.keyframe_dist_m", "must be > 0");
+  require(keyframe_deg > 0 && keyframe_deg <= 90, "nav.laser_odometry.keyframe_deg",
+          "must be in (0, 90]");
+  require(max_range_m > 0, "nav.laser_odometry.max_range_m", "must be > 0");
+  require(min_points >= 5, "nav.laser_odometry.min_points", "must be >= 5");
+  require(min_spread_m >= 0, "nav.laser_odometry.min_spread_m", "must be >= 0");
+  require(min_goodness >= 0 && min_goodness <= 1, "nav.laser_odometry.min_goodness",
+          "must be in [0, 1]");
+  require(max_correction_m > 0, "nav.laser_odometry.max_correction_m", "must be > 0");
+  require(max_correction_deg > 0, "nav.laser_odometry.max_correction_deg", "must be > 0");
+}
+
+namespace {
+CPose2D toMrpt(const hw::Pose2D& p) {
+  return CPose2D(p.x, p.y, p.theta);
+}
+hw::Pose2D fromMrpt(const CPose2D& p) {
+  return {p.x(), p.y(), p.phi()};
+}
+}  // namespace
+
+struct LaserOdometry::Impl {
+  mrpt::slam::CICP icp;
+  struct Stamped {
+    double t;
+    CPose2D wheel;
+  };
+  std::deque<Stamped> history;  // recent wheel poses, to place a scan at its own time
+  bool have_anchor = false;
+  CPose2D anchor_wheel, anchor_pose;  // a wheel pose and the corrected pose at that moment
+  bool have_kf = false;
+  CPose2D kf_pose;
+  mrpt::maps::CSimplePointsMap kf_map;
+  double last_scan_stamp = -1e300;
+  double ms_sum = 0;
+
+  CPose2D corrected(const CPose2D& wheel) const {
+    if (!have_anchor) return wheel;
+    return anchor_pose + (wheel - anchor_wheel);
+  }
+  // Wheel pose at time t, linearly interpolated (scans and odometry are not read together).
+  bool wheelAt(double t, CPose2D& out) const {
+    if (history.empty()) return false;
+    if (t <= history.front().t) {
+      out = history.front().wheel;
+      return true;
+    }
+    for (size_t i = 1; i < history.size(); ++i)
+      if (history[i].t >= t) {
+        const auto& a = history[i - 1];
+        const auto& b = history[i];
+        const double f = b.t > a.t ? (t - a.t) / (b.t - a.t) : 1.0;
+        const CPose2D d = b.wheel - a.wheel;
+        out = a.wheel + CPose2D(f * d.x(), f * d.y(), f * d.phi());
+        return true;
+      }
+    out = history.back().wheel;
+    return true;
+  }
+};
+
+LaserOdometry::LaserOdometry(LaserOdometryParams params) : params_(params) {
+  params_.validate();
+  impl_ = std::make_unique<Impl>();
+  auto& o = impl_->icp.options;
+  o.ICP_algorithm = mrpt::slam::icpClassic;
+  o.maxIterations = 60;
+  // Start with a wide association distance (the wheel guess can be a few cm and degrees off)
+  // and let ICP shrink it as it converges.
+  o.thresholdDist = 0.3;
+  o.thresholdAng = 2.0 * M_PI / 180;
+  o.ALFA = 0.5;
+  o.smallestThresholdDist = 0.03;
+  o.onlyUniqueRobust = false;
+  o.doRANSAC = false;
+  o.skip_cov_calculation = true;
+  o.skip_quality_calculation = true;
+  impl_->icp.setMinLoggingLevel(mrpt::system::LVL_ERROR);
+}
+LaserOdometry::~LaserOdometry() = default;
+LaserOdometry::LaserOdometry(LaserOdometry&&) noexcept = default;
+LaserOdometry& LaserOdometry::operator=(LaserOdometry&&) noexcept = default;
+
+hw::Pose2D LaserOdometry::wheel(const hw::Pose2D& wheel_pose, double stamp) {
+  auto& I = *impl_;
+  if (I.history.empty() || stamp > I.history.back().t)
+    I.history.push_back({stamp, toMrpt(wheel_pose)});
+  while (I.history.size() > 2 && I.history.front().t < stamp - 3.0) I.history.pop_front();
+  if (!I.have_anchor) {
+    I.anchor_wheel = I.anchor_pose = toMrpt(wheel_pose);
+    I.have_anchor = true;
+  }
+  return fromMrpt(I.corrected(toMrpt(wheel_pose)));
+}
+
+hw::Pose2D LaserOdometry::pose() const {
+  const auto& I = *impl_;
+  if (I.history.empty()) return {};
+  return fromMrpt(I.corrected(I.history.back().wheel));
+}
+
+void LaserOdometry::scan(const hw::RangeScan& sc) {
+  auto& I = *impl_;
+  if (!params_.enabled || sc.kind != hw::RangeScan::Kind::Laser) return;
+  if (sc.stamp <= I.last_scan_stamp || I.history.empty()) return;
+  I.last_scan_stamp = sc.stamp;
+  ++stats_.scans;
+  mrpt::maps::CSimplePointsMap cur;
+  const size_t n = std::min(sc.angles.size(), sc.ranges.size());
+  const double rmax = std::min<double>(params_.max_range_m, sc.max_range);
+  for (size_t i = 0; i < n; ++i) {
+    const double r = sc.ranges[i];
+    if (!std::isfinite(r) || r >= rmax || r < sc.min_range) continue;
+    const double a = sc.mount.theta + sc.angles[i];
+    cur.insertPoint(static_cast<float>(sc.mount.x + r * std::cos(a)),
+                    static_cast<float>(sc.mount.y + r * std::sin(a)), 0.f);
+  }
+  if (static_cast<int>(cur.size()) < params_.min_points) return;
+  {
+    // Spread of the points across their main axis (smaller eigenvalue of their covariance).
+    const auto& xs = cur.getPointsBufferRef_x();
+    const auto& ys = cur.getPointsBufferRef_y();
+    double mx = 0, my = 0;
+    for (size_t i = 0; i < xs.size(); ++i) mx += xs[i], my += ys[i];
+    mx /= xs.size(), my /= xs.size();
+    double sxx = 0, syy = 0, sxy = 0;
+    for (size_t i = 0; i < xs.size(); ++i) {
+      const double dx = xs[i] - mx, dy = ys[i] - my;
+      sxx += dx * dx, syy += dy * dy, sxy += dx * dy;
+    }
+    sxx /= xs.size(), syy /= xs.size(), sxy /= xs.size();
+    const double lmin = 0.5 * (sxx + syy) - std::sqrt(0.25 * (sxx - syy) * (sxx - syy) + sxy * sxy);
+    if (lmin < params_.min_spread_m * params_.min_spread_m) {
+      ++stats_.rejected;
+      return;
+    }
+  }
+
+  CPose2D wheel_s;
+  I.wheelAt(sc.stamp, wheel_s);
+  const CPose2D predicted = I.corrected(wheel_s);
+  auto newKeyframe = [&](const CPose2D& at) {
+    I.kf_pose = at;
+    I.kf_map = cur;
+    I.have_kf = true;
+    ++stats_.keyframes;
+  };
+  if (!I.have_kf) {
+    newKeyframe(predicted);
+    return;
+  }
+  const CPose2D guess = predicted - I.kf_pose;  // current robot in the keyframe's frame
+  const auto t0 = std::chrono::steady_clock::now();
+  mrpt::slam::CICP::TReturnInfo info;
+  const auto pdf = I.icp.Align(&I.kf_map, &cur, guess, info);
+  I.ms_sum +=
+      std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  const CPose2D est = pdf->getMeanVal();
+  const CPose2D diff = est - guess;
+  const bool ok = info.goodness >= params_.min_goodness &&
+                  std::hypot(diff.x(), diff.y()) <= params_.max_correction_m &&
+                  std::abs(diff.phi()) <= params_.max_correction_deg * M_PI / 180;
+  CPose2D now_pose = predicted;
+  if (ok) {
+    ++stats_.aligned;
+    now_pose = I.kf_pose + est;
+    I.anchor_wheel = wheel_s;
+    I.anchor_pose = now_pose;
+  } else {
+    ++stats_.rejected;
+  }
+  ++stats_.attempts;
+  stats_.ms_mean = I.ms_sum / stats_.attempts;
+  const CPose2D rel = now_pose - I.kf_pose;
+  // A refused alignment also starts a new keyframe once the robot is well away from the old
+  // one: aligning ever larger displacements only gets worse.
+  const double k = ok ? 1.0 : 2.0;
+  if (std::hypot(rel.x(), rel.y()) >= k * params_.keyframe_dist_m ||
+      std::abs(rel.phi()) >= k * params_.keyframe_deg * M_PI / 180)
+    newKeyframe(now_pose);
+}
+
+}  // namespace sketchnav::nav
