@@ -317,6 +317,18 @@ struct Executive::Impl {
         hold |= t.state == LmState::Tracking && now - t.last_seen <= s.exec.servo_hold_s + 0.5;
       if (hold && tracker.progress(pose).remaining_m < -s.exec.miss_slack_m) hold = false;
     }
+    // At the goal: a landmark of the last section that was seen moves the goal when it is
+    // passed (re-fit), so pass it first and judge arrival against the corrected goal.
+    if (!hold && !tracker.finished() && tracker.current() + 1 == tracker.count() &&
+        tracker.progress(pose).to_end_m <= s.sections.goal_radius_m) {
+      const int kl = tracker.current();
+      for (size_t i = 0; i < tracks[kl].size() && status == RunStatus::Running; ++i) {
+        const auto st = tracks[kl][i].state;
+        if (st == LmState::Tracking || (st == LmState::Pending && tracks[kl][i].frames_seen > 0))
+          passLandmark(kl, static_cast<int>(i), false);
+      }
+      if (status != RunStatus::Running) return;
+    }
     if (!hold && tracker.update(pose) > 0) closeSections(before);
     if (status != RunStatus::Running) return;
     if (tracker.finished()) {
