@@ -215,6 +215,19 @@ struct Executive::Impl {
       log::warn("nav", why);
   }
 
+  // Turn state for telemetry from a signed bearing or yaw rate.
+  static const char* turnOf(double x) {
+    return std::abs(x) < 0.05 ? "Straight" : (x > 0 ? "Left" : "Right");
+  }
+  // Head for a robot-frame bearing: yaw rate proportional to it; forward speed slowed by its
+  // cosine (times `scale`), and zero above turn_in_place_deg (turn on the spot first).
+  void headFor(double bearing, double scale, double& v, double& w) const {
+    w = std::clamp(s.exec.k_heading * bearing, -s.exec.max_w, s.exec.max_w);
+    v = std::abs(bearing) > s.exec.turn_in_place_deg * M_PI / 180
+            ? 0.0
+            : s.exec.v_cruise * std::max(0.2, std::cos(bearing)) * scale;
+  }
+
   // Median laser range (laser preferred over the wide sonar cones) along a robot-frame bearing.
   double rangeAt(double bearing) const {
     std::vector<double> r;
@@ -493,11 +506,8 @@ struct Executive::Impl {
         target_bearing = std::clamp(target_bearing, pred.bearing - m, pred.bearing + m);
         looking = target_bearing != la.bearing;
       }
-      w = std::clamp(s.exec.k_heading * target_bearing, -s.exec.max_w, s.exec.max_w);
-      v = std::abs(target_bearing) > s.exec.turn_in_place_deg * M_PI / 180
-              ? 0.0
-              : s.exec.v_cruise * std::max(0.2, std::cos(target_bearing));
-      turn = std::abs(target_bearing) < 0.05 ? "Straight" : (target_bearing > 0 ? "Left" : "Right");
+      headFor(target_bearing, 1.0, v, w);
+      turn = turnOf(target_bearing);
       if (looking) mode = "look";
     }
     // Side of the next landmark, for the avoidance's rotation direction.
@@ -532,13 +542,9 @@ struct Executive::Impl {
           event({{"type", "avoid_end"}, {"side", "none"}, {"docking", true}});
         }
         target_bearing = pg.bearing;
-        w = std::clamp(s.exec.k_heading * pg.bearing, -s.exec.max_w, s.exec.max_w);
-        v = std::abs(pg.bearing) > s.exec.turn_in_place_deg * M_PI / 180
-                ? 0.0
-                : s.exec.v_cruise * std::max(0.2, std::cos(pg.bearing)) *
-                      std::clamp(pg.range / 0.6, 0.3, 1.0);
+        headFor(pg.bearing, std::clamp(pg.range / 0.6, 0.3, 1.0), v, w);  // slow in the last 0.6 m
         mode = "dock";
-        turn = std::abs(pg.bearing) < 0.05 ? "Straight" : (pg.bearing > 0 ? "Left" : "Right");
+        turn = turnOf(pg.bearing);
       }
     }
     // Stuck recovery: the reactive layers can livelock (boxed in between furniture, the route
@@ -578,7 +584,7 @@ struct Executive::Impl {
       w = std::clamp(s.avoid.k_heading * a, -s.exec.max_w, s.exec.max_w);
       v = std::abs(a) > 0.35 ? 0.0 : avoider.capSpeed(scans, 0.7 * s.exec.v_cruise);
       mode = "recover";
-      turn = std::abs(w) < 0.05 ? "Straight" : (w > 0 ? "Left" : "Right");
+      turn = turnOf(w);
       const bool blocked = std::abs(a) <= 0.35 && v <= 0;
       if (std::hypot(pose.x - rec_from.x, pose.y - rec_from.y) >= s.exec.recover_m ||
           now - rec_t0 > s.exec.recover_s || blocked) {
@@ -608,7 +614,7 @@ struct Executive::Impl {
         v = av.v;
         w = av.w;
         mode = "avoid";
-        turn = std::abs(w) < 0.05 ? "Straight" : (w > 0 ? "Left" : "Right");
+        turn = turnOf(w);
       } else {
         v = avoider.capSpeed(scans, v);
       }
