@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <optional>
 #include <sstream>
 
 #include "sketchnav/core/error.h"
@@ -98,13 +99,17 @@ class RunObserver final : public nav::ExecutiveObserver {
                "mode,turn,section,landmark,front_free_m\n";
     }
   }
-  std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
+  std::vector<hw::Pose2D> odom;              // for hardware runs' trajectory
+  std::optional<Eigen::Vector2d> goal_odom;  // where the executive finally put the goal
 
   std::function<void(const Json&)> on_event;  // RunOptions hooks
   std::function<void(const nav::TelemetryRow&)> on_tick;
 
   void onEvent(const nlohmann::json& e) override {
     if (on_event) on_event(e);
+    if (e.value("type", "") == "section_done" && e.value("section", -1) == sections_ - 1 &&
+        e.contains("end_odom"))
+      goal_odom = Eigen::Vector2d(e["end_odom"][0].get<double>(), e["end_odom"][1].get<double>());
     if (events_.is_open()) events_ << e.dump() << std::endl;  // flushed per line
     if (!progress_) return;
     const std::string type = e.value("type", "");
@@ -469,6 +474,26 @@ Json runNavigation(const RunOptions& o) {
     s["min_clearance_m"] = simr->minClearance();
     s["path_length_m"] = simr->stats().distance;
     s["frames_rendered"] = simr->stats().frames_rendered;
+    // Where the robot's belief went wrong, against ground truth: its odometry (the executive's
+    // pose, scan-matched) and where the re-fitted sketch put the goal. The distance to the goal
+    // is roughly their sum, so a short stop shows which one to work on.
+    if (!observer.odom.empty()) {
+      const hw::Pose2D o = observer.odom.back();
+      const double cs = std::cos(w.start.theta), ss = std::sin(w.start.theta);
+      auto toWorld = [&](double x, double y) {
+        return Eigen::Vector2d(w.start.x + cs * x - ss * y, w.start.y + ss * x + cs * y);
+      };
+      Json d;
+      d["odometry_error_m"] = (toWorld(o.x, o.y) - Eigen::Vector2d(tp.x, tp.y)).norm();
+      d["odometry_heading_error_deg"] =
+          nav::wrapAngle(w.start.theta + o.theta - tp.theta) * 180.0 / M_PI;
+      if (observer.goal_odom) {
+        const Eigen::Vector2d g = toWorld(observer.goal_odom->x(), observer.goal_odom->y());
+        d["goal_estimate_error_m"] = (g - w.goal.centre).norm();
+        d["goal_estimate_world"] = {g.x(), g.y()};
+      }
+      s["diagnostics"] = d;
+    }
     s["render_s"] = simr->stats().render_seconds;
     // Ground truth decides success in simulation: the executive's belief is not enough.
     if (collided) {

@@ -44,6 +44,8 @@ void RouteParams::validate() const {
           "must be in (0, 0.5)");
   require(robust_scale > 0 && robust_scale <= 10, "route.robust_scale", "must be in (0, 10]");
   require(outlier_residual > 0, "route.outlier_residual", "must be positive");
+  require(start_tangent_m > 0 && start_tangent_m <= 10, "route.start_tangent_m",
+          "must be in (0, 10] m");
   require(ahead_angle_deg >= 0 && ahead_angle_deg < 90, "route.ahead_angle_deg",
           "must be in [0, 90)");
 }
@@ -231,7 +233,18 @@ Route toRoute(const Sketch& sk, const RouteParams& params) {
     route.total_length_m += sec.length_m;
     route.sections.push_back(std::move(sec));
   }
-  route.start_heading_rad = route.sections.front().heading_rad;
+  // The drawn line's own direction at the start, not the first section's: the two differ by
+  // 20 degrees and more when a short first stroke bends into a long one (the bend is below
+  // the simplification tolerance), and the whole route would be turned by that.
+  {
+    const double reach_px = params.start_tangent_m / s;
+    Eigen::Vector2d acc(0, 0);
+    for (size_t i = 1; i < path.size() && (i == 1 || arc[i] <= reach_px); ++i)
+      if ((path[i] - path[0]).norm() > 1e-9)
+        acc += (path[i] - path[0]).normalized() * std::min(arc[i], reach_px);
+    route.start_heading_rad =
+        acc.norm() > 1e-9 ? std::atan2(-acc.y(), acc.x()) : route.sections.front().heading_rad;
+  }
 
   const double near = detail::nearDistancePx(sk);
   const double ahead_tan = std::tan(params.ahead_angle_deg * M_PI / 180);

@@ -217,3 +217,22 @@ TEST(Route, RouteJsonHasTheContractFields) {
   EXPECT_TRUE(j.contains("scale_residual"));
   EXPECT_EQ(j["guide_points_m"].size(), 3u);
 }
+
+TEST(Route, StartHeadingFollowsAShortFirstStrokeTheSimplificationDrops) {
+  // The line leaves the start 27 degrees up-canvas for 1.3 m, then bends into a long leg: the
+  // bend is within the simplification tolerance, so the first section runs straight from the
+  // start, but the robot is put down along the stroke the user drew.
+  Sketch s = fixtures::lSketch();
+  const double px_per_m = 1.0 / fixtures::kTrueScale;
+  const Eigen::Vector2d bend = s.start + Eigen::Vector2d(1.2, -0.6) * px_per_m;
+  s.path = fixtures::wobbly({s.start, bend, {800, 600}, {800, 100}}, 5, 0.5, 3);
+  s.path.front() = s.start;
+  s.path.back() = s.goal;
+  const Route r = toRoute(s);
+  ASSERT_EQ(r.sections.size(), 2u) << "the bend was expected to be simplified away";
+  EXPECT_NEAR(r.sections[0].heading_rad, 0.0, 0.06);
+  EXPECT_NEAR(r.start_heading_rad, std::atan2(0.6, 1.2), 0.06);
+  RouteParams p;
+  p.start_tangent_m = 0;
+  EXPECT_THROW(toRoute(s, p), InputError);
+}

@@ -44,6 +44,7 @@ void ExecutiveParams::validate() const {
   require(fit_max_scale_change >= 0 && fit_max_scale_change < 1, "nav.fit_max_scale_change",
           "must be in [0, 1)");
   require(fit_local_gain >= 0 && fit_local_gain <= 1, "nav.fit_local_gain", "must be in [0, 1]");
+  require(fit_outlier_m >= 0, "nav.fit_outlier_m", "must be >= 0 (0 = keep every fix)");
   require(stuck_s > 0, "nav.stuck_s", "must be > 0");
   require(goal_settle_m >= 0, "nav.goal_settle_m", "must be >= 0");
   require(goal_settle_s > 0, "nav.goal_settle_s", "must be > 0");
@@ -62,6 +63,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.exec, c, "nav");
   applyConfig(s.sections, c, "nav.sections");
   applyConfig(s.select, c, "nav.select");
+  applyConfig(s.locate, c, "nav.locate");
   applyConfig(s.avoid, c, "nav.avoid");
   applyConfig(s.safety, c, "nav.safety");
   applyConfig(s.laser_odometry, c, "nav.laser_odometry");
@@ -133,8 +135,7 @@ struct LmTrack {
   LmState state = LmState::Pending;
   int frames_seen = 0, max_inliers = 0;
   double last_seen = -1e300, last_range = 0, last_bearing = 0;
-  bool have_fix = false;           // a ranged sighting exists (last_fix is valid)
-  Eigen::Vector2d last_fix{0, 0};  // where that sighting put the landmark (odometry frame)
+  std::vector<Sighting> sightings;  // within fix range, for locateLandmark()
 };
 }  // namespace
 
@@ -190,6 +191,7 @@ struct Executive::Impl {
         lodo(st.laser_odometry) {
     s.exec.validate();
     s.select.validate();
+    s.locate.validate();
     if (!dev.base || !dev.clock) throw std::logic_error("Executive: base and clock are required");
     if (!dev.camera) s.safety.require_camera = false, safety = SafetySupervisor(s.safety);
     if (dev.ranges.empty()) s.safety.require_range = false, safety = SafetySupervisor(s.safety);
@@ -454,10 +456,10 @@ struct Executive::Impl {
         t.last_seen = now;
         t.last_range = range;
         t.last_bearing = d.bearing;
-        if (range > 0) {
-          const double b = pose.theta + d.bearing;
-          t.last_fix = {pose.x + range * std::cos(b), pose.y + range * std::sin(b)};
-          t.have_fix = true;
+        // Far ranges may be something else along the bearing; an unranged bearing still helps.
+        if (range <= fixRange()) {
+          if (t.sightings.size() >= 80) t.sightings.erase(t.sightings.begin());
+          t.sightings.push_back({{pose.x, pose.y}, pose.theta + d.bearing, range});
         }
         if (n == 0) {
           const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
@@ -686,6 +688,10 @@ struct Executive::Impl {
   // Range at which a servoed landmark counts as passed: its lateral distance from the path,
   // or, for a landmark ahead beyond the section's end (on the wall the route turns at), its
   // sketched distance from that end, so that re-anchoring on it puts the end where the robot is.
+  // Sightings further than this are not ranged fixes (the laser along the bearing may hit
+  // something else that far out).
+  double fixRange() const { return s.exec.max_approach_m + 1.5; }
+
   double passDistance(int k, const mapsketch::ExpectedLandmark& lm) const {
     const auto& sec = tracker.route().sections[k];
     double d = lm.range_m;
@@ -713,13 +719,23 @@ struct Executive::Impl {
               {"class", lm.class_name},    {"section", k},
               {"range_m", tr.last_range},  {"frames_seen", tr.frames_seen},
               {"in_view", seen_close}};
-    // Far sightings are left out: the laser range along their bearing may be something else.
-    if (tr.have_fix && tr.last_range <= s.exec.max_approach_m + 1.5) {
-      // Where the landmark really is (odometry frame, from its last ranged sighting) vs where
-      // the sketch puts it: rotate the route about the last trusted fix, then shift it, each by
-      // its gain. A landmark that slid out of view when close was seen as well as one passed
-      // in view, and the last landmark before the goal is often passed that way.
-      const Eigen::Vector2d seen = tr.last_fix;
+    // Where the landmark really is (odometry frame: its bearings crossed, and the ranges that
+    // agree) vs where the sketch puts it: refit or rotate the route, then shift it, each by
+    // its gain. A landmark that slid out of view when close was seen as well as one passed in
+    // view, and the last landmark before the goal is often passed that way.
+    const LandmarkFix lf = locateLandmark(tr.sightings, s.locate);
+    if (lf.ok) {
+      const Eigen::Vector2d seen = lf.position;
+      e["fix_method"] = lf.triangulated ? "bearings" : "ranges";
+      e["fix_rays"] = lf.rays;
+      e["fix_ranges_used"] = lf.ranges_used;
+      e["fix_ranges_dropped"] = lf.ranges_dropped;
+      json rays = json::array();
+      for (const auto& q : tr.sightings)
+        rays.push_back(
+            {std::round(q.origin.x() * 1000) / 1000, std::round(q.origin.y() * 1000) / 1000,
+             std::round(q.direction * 10000) / 10000, std::round(q.range_m * 1000) / 1000});
+      e["sightings"] = rays;
       const Eigen::Vector2d shift = seen - tracker.toOdom(lm.position_m);
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
@@ -733,12 +749,16 @@ struct Executive::Impl {
       for (const auto& a : fr)
         for (const auto& b : fr) span = std::max(span, (a - b).norm());
       if (n >= 3 && span >= s.exec.fit_min_span_m) {
-        const auto f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change);
-        tracker.reanchor(lm.position_m, seen, s.exec.fit_local_gain);
+        const auto f =
+            tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
+        // Not towards the newest fix when the fit found it an outlier.
+        if (f.used.empty() || f.used.back())
+          tracker.reanchor(lm.position_m, seen, s.exec.fit_local_gain);
         e["fit_rotation_deg"] = f.rotation * 180 / M_PI;
         e["fit_scale"] = tracker.scale();
         e["fit_rms_m"] = f.rms;
         e["fit_fixes"] = n;
+        e["fit_dropped"] = f.dropped;
       } else {
         const double rot = tracker.realign(lm.position_m, seen, fix_route, fix_odom,
                                            s.exec.realign_gain, s.exec.realign_baseline_m);
@@ -747,6 +767,9 @@ struct Executive::Impl {
         e["reanchor_m"] = shift.norm() * s.exec.reanchor_gain;
       }
       e["disagreement_m"] = shift.norm();
+      // Both ends of the fix, for judging the sketch's and the estimator's errors offline.
+      e["fix_route"] = {lm.position_m.x(), lm.position_m.y()};
+      e["fix_odom"] = {seen.x(), seen.y()};
       fix_route = lm.position_m;
       fix_odom = seen;
     }

@@ -129,3 +129,51 @@ TEST(SectionTracker, RealignCorrectsAWrongStartHeading) {
   // Too short a baseline: no rotation.
   EXPECT_EQ(t.realign({0.5, 0}, {0.4, 0.3}, {0, 0}, {0, 0}, 1.0), 0.0);
 }
+
+namespace {
+// Fixes of a route seen through a known similarity (odom = s R(a) route + t), route start (0, 0).
+struct Fixes {
+  std::vector<Eigen::Vector2d> route, odom;
+};
+Fixes seenThrough(double s, double a, const Eigen::Vector2d& t) {
+  Fixes f;
+  for (const Eigen::Vector2d p :
+       {Eigen::Vector2d(0, 0), Eigen::Vector2d(3, -1), Eigen::Vector2d(6, 1),
+        Eigen::Vector2d(9, -2), Eigen::Vector2d(12, 0), Eigen::Vector2d(14, -4)}) {
+    f.route.push_back(p);
+    f.odom.push_back(s * Eigen::Vector2d(std::cos(a) * p.x() - std::sin(a) * p.y(),
+                                         std::sin(a) * p.x() + std::cos(a) * p.y()) +
+                     t);
+  }
+  return f;
+}
+}  // namespace
+
+TEST(SectionTracker, FitSimilarityRecoversRotationScaleAndShift) {
+  SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const Fixes f = seenThrough(1.08, 0.1, {0.3, -0.2});
+  const auto fit = t.fitSimilarity(f.route, f.odom, 0.15);
+  ASSERT_TRUE(fit.ok);
+  EXPECT_NEAR(t.scale(), 1.08, 1e-9);
+  EXPECT_LT(fit.rms, 1e-9);
+  EXPECT_LT((t.toOdom({14, -4}) - f.odom.back()).norm(), 1e-9);
+}
+
+TEST(SectionTracker, FitSimilarityLeavesOutAFixFarOffTheOthers) {
+  const Fixes f0 = seenThrough(1.0, 0.05, {0, 0});
+  Fixes f = f0;
+  f.odom[3] += Eigen::Vector2d(0.9, 0.0);  // ranged on the bench behind the landmark
+  SectionTracker kept(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  kept.fitSimilarity(f.route, f.odom, 0.15, 0.0);
+  SectionTracker robust(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const auto fit = robust.fitSimilarity(f.route, f.odom, 0.15, 0.5);
+  ASSERT_TRUE(fit.ok);
+  EXPECT_EQ(fit.dropped, 1);
+  ASSERT_EQ(fit.used.size(), f.route.size());
+  EXPECT_FALSE(fit.used[3]);
+  EXPECT_LT(fit.rms, 1e-9);
+  // The goal end: exact without the outlier, pulled off with it.
+  const Eigen::Vector2d goal(14, -4), truth = f0.odom.back();
+  EXPECT_LT((robust.toOdom(goal) - truth).norm(), 1e-9);
+  EXPECT_GT((kept.toOdom(goal) - truth).norm(), 0.1);
+}

@@ -4,7 +4,8 @@
 // Route frame: the sketch canvas scaled to metres, origin at the sketch's start point,
 // x to the right on the canvas, y UP on the canvas (canvas y is flipped), so angles are CCW
 // like REP 103. The navigation executive aligns this frame with odometry by assuming the
-// robot starts at `start_m` facing `start_heading_rad` (along the first section).
+// robot starts at `start_m` facing `start_heading_rad` (along the drawn line's first
+// stretch, RouteParams::start_tangent_m; usually the first section's direction).
 #include <Eigen/Core>
 
 #include <string>
@@ -65,12 +66,17 @@ struct RouteParams {
   double outlier_residual = 0.5;      // a distance whose relative error exceeds this is reported
   double ahead_angle_deg = 20;        // a landmark within this angle of the direction of travel,
                                       // beyond the section's end, is "ahead" rather than left/right
+  double start_tangent_m = 1.0;       // [m] the robot is put down facing along the drawn line:
+                                      // its direction over this first stretch (a short first
+                                      // stroke is simplified away, but still says how the robot
+                                      // stands)
   template <class B>
   void bind(B& b) {
     b("simplify_tolerance", simplify_tolerance);
     b("robust_scale", robust_scale);
     b("outlier_residual", outlier_residual);
     b("ahead_angle_deg", ahead_angle_deg);
+    b("start_tangent_m", start_tangent_m);
   }
   void validate() const;
 };

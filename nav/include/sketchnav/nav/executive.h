@@ -56,6 +56,7 @@ struct ExecutiveParams {
   double fit_min_span_m = 5.0;         // [m]
   double fit_max_scale_change = 0.15;  // relative, per fit
   double fit_local_gain = 0.3;
+  double fit_outlier_m = 0.6;        // [m] a fix this far off the others' fit is left out
   double realign_gain = 0.8;         // how much it re-rotates the route about the previous fix
   double realign_baseline_m = 5.0;   // [m] minimum fix-to-landmark distance for that: a
                                      // sighting is good to ~0.3 m, so a shorter baseline
@@ -103,6 +104,7 @@ struct ExecutiveParams {
     b("fit_min_span_m", fit_min_span_m);
     b("fit_max_scale_change", fit_max_scale_change);
     b("fit_local_gain", fit_local_gain);
+    b("fit_outlier_m", fit_outlier_m);
     b("realign_gain", realign_gain);
     b("realign_baseline_m", realign_baseline_m);
     b("perception_period_s", perception_period_s);
@@ -129,13 +131,14 @@ struct NavSettings {
   ExecutiveParams exec;
   SectionParams sections;
   SelectParams select;
+  LocateParams locate;
   AvoidParams avoid;
   SafetyParams safety;
   LaserOdometryParams laser_odometry;
   servo::TurnLawParams servo;
 };
 
-/// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*",
+/// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*", "nav.locate.*",
 /// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "servo.*") over the defaults and
 /// validates.
 NavSettings navSettingsFrom(const Config& config);

@@ -74,15 +74,20 @@ class SectionTracker {
   /// from the user's distance guesses (10-25 % off each); several fixes a few metres apart pin
   /// scale and heading down far better, and the error of each sketched position averages out
   /// instead of being copied by a shift. The scale moves at most `max_scale_change` (relative)
-  /// per fit. Needs two or more fixes.
+  /// per fit. Needs two or more fixes. With `outlier_m` > 0, the fix furthest off the fit is
+  /// left out and the rest refitted while it is more than `outlier_m` off and more than three
+  /// fixes remain.
   struct Fit {
     bool ok = false;
-    double rotation = 0;  // [rad] change
-    double scale = 1;     // relative change
-    double rms = 0;       // [m] residual over the fixes
+    double rotation = 0;     // [rad] change
+    double scale = 1;        // relative change
+    double rms = 0;          // [m] residual over the fixes used
+    int dropped = 0;         // fixes left out as outliers
+    std::vector<bool> used;  // per fix: kept in the fit
   };
   Fit fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
-                    const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15);
+                    const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15,
+                    double outlier_m = 0);
   double scale() const { return scale_; }
 
   SectionProgress progress(const hw::Pose2D& odom) const;
