@@ -5,6 +5,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/matcher.h"
 #include "sketchnav/landmarks/model.h"
+#include "sketchnav/landmarks/recognition.h"
 #include "test_data.h"
 #include "test_recognition_support.h"
 
@@ -109,6 +110,32 @@ TEST_F(MatchFixture, WrongClassOrEmptyWindowIsNotMatched) {
   const MatchResult off = match(*model_, frame, cv::Rect(0, 0, 40, 40), "class0", MatchParams{});
   EXPECT_FALSE(off.matched);
   EXPECT_THROW(match(*model_, frame, cv::Rect(), "no-such-class", MatchParams{}), InputError);
+}
+
+TEST_F(MatchFixture, MatchReusesRecognitionsVerificationOfTheSameFrame) {
+  const cv::Mat H = similarity(20, 0.9, 40, 10);
+  const FrameFeatures f = computeFrameFeatures(*model_, frameWith(H));
+  RecognitionParams rp;
+  const auto r = recognise(*model_, f, {}, 1, rp);
+  ASSERT_FALSE(r.empty());
+  ASSERT_FALSE(r[0].rejected);
+  ASSERT_EQ(r[0].class_name, "class0");
+  ASSERT_EQ(f.photo_cache->verified.size(), 1u);
+  const MatchResult fresh =
+      match(*model_, FrameFeatures{f.features, f.words, nullptr}, cv::Rect(), "class0", rp.match);
+  const MatchResult reused = match(*model_, f, cv::Rect(), "class0", rp.match);
+  checkRecovered(H, reused);
+  EXPECT_EQ(reused.inliers, r[0].inliers);
+  EXPECT_EQ(reused.database_photo, fresh.database_photo);
+  EXPECT_EQ(reused.window, cv::Rect(0, 0, 640, 480));
+  // It is the cached verification (marked here), not a new search; other verification settings
+  // or another class search afresh.
+  f.photo_cache->verified[0].result.inliers = 999;
+  EXPECT_EQ(match(*model_, f, cv::Rect(), "class0", rp.match).inliers, 999);
+  MatchParams other = rp.match;
+  other.min_inliers += 1;
+  EXPECT_EQ(match(*model_, f, cv::Rect(), "class0", other).inliers, fresh.inliers);
+  EXPECT_FALSE(match(*model_, f, cv::Rect(), "class1", rp.match).matched);
 }
 
 TEST(MatchPhotoOrder, TheSmallObjectsPhotoIsTriedFirstInAClutteredFrame) {
