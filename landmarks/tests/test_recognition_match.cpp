@@ -138,6 +138,60 @@ TEST_F(MatchFixture, MatchReusesRecognitionsVerificationOfTheSameFrame) {
   EXPECT_FALSE(match(*model_, f, cv::Rect(), "class1", rp.match).matched);
 }
 
+TEST(ViewSynthesis, MoreInliersOnAStronglyTiltedView) {
+  // One flat photo; the frame sees it at ~70 degrees off its normal (compressed 3x along x).
+  const std::string root = test::tempDir("recog-synth");
+  std::filesystem::create_directories(root + "/class0");
+  std::filesystem::create_directories(root + "/class1");
+  cv::imwrite(root + "/class0/flat.png", test::texturedImage(320, 240, 1000));
+  cv::imwrite(root + "/class1/flat.png", test::texturedImage(320, 240, 1001));
+  ModelParams p;
+  p.vocabulary_size = 50;
+  const LandmarkModel plain = trainModel(root, p);
+  p.synth_views = 2;
+  p.synth_tilt = 2.0;
+  const LandmarkModel synth = trainModel(root, p);
+  // Database keypoints of the synthesised views are in the photo's pixels.
+  const auto& ph = synth.photos()[synth.photosOfClass(0)[0]];
+  EXPECT_GT(ph.keypoints.size(), plain.photos()[plain.photosOfClass(0)[0]].keypoints.size());
+  for (const auto& k : ph.keypoints) {
+    EXPECT_GE(k.pt.x, 0);
+    EXPECT_LT(k.pt.x, 320);
+  }
+  int plain_sum = 0, synth_sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat H = (cv::Mat_<double>(3, 3) << 1.0 / 3, 0.05 * i, 260, 0.1, 1.2, 80 + 20 * i, 0, 0, 1);
+    if (i == 2) H = (cv::Mat_<double>(3, 3) << 1.2, 0, 140, 0.05, 0.4, 150, 0, 0, 1);  // along y
+    cv::Mat frame(480, 640, CV_8UC3);
+    cv::RNG(3 + i).fill(frame, cv::RNG::UNIFORM, 90, 160);
+    cv::GaussianBlur(frame, frame, cv::Size(0, 0), 4);
+    cv::warpPerspective(test::texturedImage(320, 240, 1000), frame, H, frame.size(), cv::INTER_AREA,
+                        cv::BORDER_TRANSPARENT);
+    MatchParams mp;
+    mp.min_inliers = 8;
+    const MatchResult a = match(plain, frame, cv::Rect(), "class0", mp);
+    const MatchResult b = match(synth, frame, cv::Rect(), "class0", mp);
+    plain_sum += a.inliers;
+    synth_sum += b.inliers;
+    // The synthesised view's correspondences agree with the true warp.
+    if (b.matched) {
+      std::vector<cv::Point2f> proj;
+      cv::perspectiveTransform(b.x_d, proj, H);
+      int close = 0;
+      for (size_t k = 0; k < proj.size(); ++k) close += cv::norm(proj[k] - b.x_t[k]) < 8.0;
+      EXPECT_GE(close, static_cast<int>(0.9 * proj.size()));
+    }
+  }
+  EXPECT_GT(synth_sum, plain_sum + plain_sum / 2 + 10);
+  EXPECT_THROW(
+      [] {
+        ModelParams bad;
+        bad.synth_views = 5;
+        bad.validate();
+      }(),
+      InputError);
+}
+
 TEST(MatchPhotoOrder, TheSmallObjectsPhotoIsTriedFirstInAClutteredFrame) {
   // A class photographed from several sides (five different faces); the frame shows one face
   // small, in clutter, so the frame's BoW histogram is mostly background. Only one photo is
