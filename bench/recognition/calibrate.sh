@@ -43,7 +43,7 @@ if [ ! -d "$OUT/fit" ]; then
   done
 fi
 
-PROBE=$(find "$DATA/val" -name '*.jpg' | sort | head -1)
+PROBE=$(find "$DATA/val" -name '*.jpg' | sort | sed -n 1p)  # not head: SIGPIPE under pipefail
 [ -f "$OUT/fit.slm" ] && "$BIN" recognise --model "$OUT/fit.slm" "$PROBE" >/dev/null 2>&1 ||
   "$BIN" --json train --landmarks "$OUT/fit" -o "$OUT/fit.slm" > "$OUT/train_fit.json"
 

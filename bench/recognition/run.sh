@@ -41,7 +41,7 @@ NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
 COMBINED="--set landmarks.recognition.combined_score=true"
 mkdir -p "$OUT"
 
-PROBE=$(find "$DATA/val" -name '*.jpg' | sort | head -1)
+PROBE=$(find "$DATA/val" -name '*.jpg' | sort | sed -n 1p)  # not head: SIGPIPE under pipefail
 usable() {  # model file: exists and this build can read it (older format versions cannot)
   [ -f "$1" ] && "$BIN" recognise --model "$1" "$PROBE" >/dev/null 2>&1
 }
