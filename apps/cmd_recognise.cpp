@@ -7,6 +7,7 @@
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
+#include <fstream>
 #include <iostream>
 #include <map>
 
@@ -37,6 +38,10 @@ struct Runner {
   bool with_match = false;  // also run match() for the recognised class (servo cost)
   lm::MatchParams match_params;
   lm::FeatureParams frame_features;  // SIFT settings for the images (model's frame_* by default)
+  std::ofstream* details = nullptr;  // --details: one JSON line per evaluated image
+  // CPU ms per stage, summed over images: features (SIFT, RootSIFT, colours, words), objectness,
+  // recognise, match.
+  mutable double stage_ms[4] = {0, 0, 0, 0};
 
   cv::Mat prepare(const cv::Mat& img) const {
     if (frame_size.area() == 0) return img;
@@ -59,10 +64,18 @@ struct Runner {
     std::vector<cv::Rect> boxes;
     if (objectness)
       for (const auto& w : objectness->propose(img, windows)) boxes.push_back(w.box);
+    const double c1 = threadCpuMs();
     const lm::FrameFeatures frame = lm::computeFrameFeatures(model, img, frame_features);
+    const double c2 = threadCpuMs();
     auto out = lm::recognise(model, frame, boxes, top_k, params);
+    const double c3 = threadCpuMs();
     if (with_match && !out.empty() && !out.front().rejected)
       lm::match(model, frame, out.front().window, out.front().class_name, match_params);
+    const double c4 = threadCpuMs();
+    stage_ms[0] += c2 - c1;
+    stage_ms[1] += c1 - c0;
+    stage_ms[2] += c3 - c2;
+    stage_ms[3] += c4 - c3;
     ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
     if (cpu_ms) *cpu_ms = threadCpuMs() - c0;
     return out;
@@ -108,7 +121,27 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
       }
       img = runner.prepare(img);
       double ms = 0, cpu = 0;
-      const auto res = runner.run(img, 3, ms, &cpu);
+      const auto res = runner.run(img, runner.details ? 8 : 3, ms, &cpu);
+      if (runner.details) {
+        Json cands = Json::array();
+        for (const auto& r : res)
+          cands.push_back({{"class", r.class_name},
+                           {"inliers", r.inliers},
+                           {"verified", r.verified},
+                           {"vote_inliers", r.vote_inliers},
+                           {"votes", r.votes},
+                           {"vote_share", r.vote_share},
+                           {"bow_probability", r.bow_probability},
+                           {"evidence", r.evidence},
+                           {"rejected", r.rejected}});
+        *runner.details << Json{{"image", path},
+                                {"class", c.name},
+                                {"known", known},
+                                {"cpu_ms", cpu},
+                                {"candidates", cands}}
+                               .dump()
+                        << "\n";
+      }
       ms_sum += ms;
       cpu_sum += cpu;
       times.push_back(ms);
@@ -155,6 +188,11 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
             {"ms_mean", ms_sum / n},
             {"cpu_ms_mean", cpu_sum / n},
             {"index_build_ms", index_ms},
+            {"stage_cpu_ms_mean",
+             {{"features", runner.stage_ms[0] / n},
+              {"objectness", runner.stage_ms[1] / n},
+              {"recognise", runner.stage_ms[2] / n},
+              {"match", runner.stage_ms[3] / n}}},
             {"ms_p95", times[std::min(times.size() - 1, times.size() * 95 / 100)]},
             {"mode", modeJson(runner)},
             {"per_class", per_class}};
@@ -189,6 +227,7 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("eval", "folder of class folders (same layout as training): print accuracy")
       .option("top-k", "candidates printed per image", "3")
       .option("windows", "objectness windows per image (0 = the whole image)", "0")
+      .option("details", "with --eval: write one JSON line per image (candidates and evidence)")
       .option("frame", "letterbox each image into a WxH camera frame first, e.g. 640x480")
       .flag("match", "also match the recognised class (the servo's per-frame cost) in the timing")
       .flag("no-verify", "BoW + SVM only, no geometric verification (for comparisons)");
@@ -204,7 +243,7 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
   model.buildIndexes();
   const double index_ms =
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - tb).count();
-  Runner runner{model, {}, args.getInt("windows"), nullptr, {}, false, {}, {}};
+  Runner runner{model, {}, args.getInt("windows"), nullptr, {}, false, {}, {}, nullptr};
   // Frame SIFT settings: the model's frame_* limits, overridable with landmarks.frame.* (e.g.
   // bench/recognition/fast.json) without retraining.
   runner.frame_features = model.params().frameFeatures();
@@ -225,6 +264,12 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
   if (runner.windows > 0)
     runner.objectness = std::make_unique<lm::Objectness>(lm::objectnessParamsFrom(g.config));
 
+  std::ofstream details;
+  if (!args.get("details").empty()) {
+    details.open(args.get("details"));
+    if (!details) throw InputError(args.get("details") + ": cannot write --details file");
+    runner.details = &details;
+  }
   if (!args.get("eval").empty()) return evaluate(runner, args.get("eval"), index_ms, g);
 
   Json out = Json::array();
@@ -245,6 +290,8 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
       cands.push_back({{"class", r.class_name},
                        {"score", r.score},
                        {"inliers", r.inliers},
+                       {"verified", r.verified},
+                       {"evidence", r.evidence},
                        {"votes", r.votes},
                        {"bow_probability", r.bow_probability},
                        {"rejected", r.rejected},

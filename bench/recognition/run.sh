@@ -9,16 +9,23 @@
 #   no_colour        the product without the keypoint colour check (colour_tolerance 0)
 #   windows          objectness windows (10 per image) instead of the whole image
 #   frame            each photo letterboxed into a 640x480 frame, recognise + match timed
-#   frame_fast       the same with bench/recognition/fast.json (320 px / 400 keypoints for
-#                    frame SIFT, smaller searches): the <= 30 ms per frame setting
+#   frame_fast       the same with bench/recognition/fast.json (360 px / 400 keypoints for
+#                    frame SIFT, smaller vote search): the <= 30 ms per frame setting
+#   combined         the product with the combined evidence score as the decision
+#                    (landmarks.recognition.combined_score; weights from calibrate.sh)
+#   synth, synth_frame  a model with two synthesised tilted views per photo (view synthesis,
+#                    landmarks.train.synth_views=2) on photos and on frames + match
 #   rejection        three classes left out of training: their val images must be rejected
 #   rejection_no_colour  the same without the colour check
+#   rejection_combined   the same with the combined score
 #   demo             the product's 8-class demo set (share/landmarks) on all val photos in
 #                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected)
 #
 # Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
-# Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean) with
-# OpenCV on one thread; the machine's load shows in the difference. Run one benchmark at a
+# Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean, and per
+# stage: features = SIFT + RootSIFT + colours + words, recognise, match) with OpenCV on one
+# thread; the machine's load shows in the difference. match() reuses recognise()'s verification
+# of the same frame, so its cost shows only when it searches afresh. Run one benchmark at a
 # time: two would share the cores and the caches.
 # Models are cached in OUT_DIR (retrained when this build cannot read them); delete them after
 # changing the training code without changing the format version.
@@ -31,9 +38,10 @@ OUT=${3:-$root/runs/bench-recognition}
 EXCLUDED=Oatly-Oat-Milk,Yoggi-Vanilla-Yoghurt,Bravo-Orange-Juice
 FAST=$here/fast.json
 NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
+COMBINED="--set landmarks.recognition.combined_score=true"
 mkdir -p "$OUT"
 
-PROBE=$(find "$DATA/val" -name '*.jpg' | sort | head -1)
+PROBE=$(find "$DATA/val" -name '*.jpg' | sort | sed -n 1p)  # not head: SIGPIPE under pipefail
 usable() {  # model file: exists and this build can read it (older format versions cannot)
   [ -f "$1" ] && "$BIN" recognise --model "$1" "$PROBE" >/dev/null 2>&1
 }
@@ -51,6 +59,7 @@ evaluate() {  # name, model, extra args...
 train rootsift
 train sift --plain-sift
 train rootsift_excluded --exclude "$EXCLUDED"
+train synth --set landmarks.train.synth_views=2
 usable "$OUT/demo.slm" || "$BIN" --json train --landmarks "$root/share/landmarks" -o "$OUT/demo.slm" \
   > "$OUT/train_demo.json"
 
@@ -62,15 +71,19 @@ evaluate no_colour rootsift $NO_COLOUR
 evaluate windows rootsift --windows 10
 evaluate frame rootsift --frame 640x480 --match
 evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
+evaluate combined rootsift $COMBINED
+evaluate synth synth
+evaluate synth_frame synth --frame 640x480 --match
 evaluate rejection rootsift_excluded
 evaluate rejection_no_colour rootsift_excluded $NO_COLOUR
+evaluate rejection_combined rootsift_excluded $COMBINED
 evaluate demo demo --frame 640x480 --match
 
 python3 - "$OUT" <<'PY'
 import json, os, sys
 out = sys.argv[1]
 keys = ("images", "classes", "top1", "top1_ignoring_rejection", "top3", "rejected",
-        "false_rejected", "ms_mean", "cpu_ms_mean", "ms_p95")
+        "false_rejected", "ms_mean", "cpu_ms_mean", "ms_p95", "stage_cpu_ms_mean")
 summary = {}
 for f in sorted(os.listdir(out)):
     if f.startswith("eval_") and f.endswith(".json"):
@@ -81,13 +94,15 @@ for f in sorted(os.listdir(out)):
         summary.setdefault("training", {})[f[6:-5]] = {k: j.get(k) for k in ("seconds", "photos", "words")}
 json.dump(summary, open(os.path.join(out, "summary.json"), "w"), indent=2)
 fmt = lambda v: "–" if v is None else ("%.2f" % v if isinstance(v, float) and v <= 1 else "%.1f" % v if isinstance(v, float) else str(v))
-rows = ["| configuration | top-1 | top-3 | unknown rejected | false rejections | CPU ms / image | wall ms / image |",
-        "|---|---|---|---|---|---|---|"]
+rows = ["| configuration | top-1 | top-1 ignoring rejection | top-3 | unknown rejected | false rejections | CPU ms / image | features / recognise / match CPU ms | wall ms / image |",
+        "|---|---|---|---|---|---|---|---|---|"]
 for name, s in summary.items():
     if name == "training":
         continue
-    rows.append("| %s | %s | %s | %s | %s | %s | %s |" % (name, fmt(s["top1"]), fmt(s["top3"]), fmt(s["rejected"]),
-                fmt(s["false_rejected"]), fmt(s["cpu_ms_mean"]), fmt(s["ms_mean"])))
+    st = s.get("stage_cpu_ms_mean") or {}
+    stages = " / ".join("%.1f" % st.get(k, 0) for k in ("features", "recognise", "match")) if st else "–"
+    rows.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (name, fmt(s["top1"]), fmt(s["top1_ignoring_rejection"]), fmt(s["top3"]),
+                fmt(s["rejected"]), fmt(s["false_rejected"]), fmt(s["cpu_ms_mean"]), stages, fmt(s["ms_mean"])))
 open(os.path.join(out, "summary.md"), "w").write("\n".join(rows) + "\n")
 print("\n".join(rows))
 PY

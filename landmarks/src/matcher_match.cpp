@@ -44,6 +44,15 @@ FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bg
   return f;
 }
 
+namespace {
+// The settings that decide whether a photo verifies (the photo order and budget do not).
+bool sameVerification(const MatchParams& a, const MatchParams& b) {
+  return a.ratio == b.ratio && a.min_inliers == b.min_inliers && a.ransac_px == b.ransac_px &&
+         a.ransac_iterations == b.ransac_iterations && a.colour_tolerance == b.colour_tolerance &&
+         a.colour_min_fraction == b.colour_min_fraction;
+}
+}  // namespace
+
 namespace detail {
 
 std::vector<int> keypointsInWindow(const FrameFeatures& frame, const cv::Rect& window) {
@@ -109,7 +118,9 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
     for (const auto& c : corr) (gate(c.q, c.d) ? ok : wrong_colour).push_back(c);
     corr.swap(ok);
   }
-  if (static_cast<int>(corr.size()) < p.min_inliers) return r;
+  // Below min_inliers RANSAC still runs (cheap on few points): the inlier count is evidence for
+  // recognise()'s combined score.
+  if (corr.size() < 4) return r;
   std::vector<cv::Point2f> src, dst;  // database -> frame
   src.reserve(corr.size());
   dst.reserve(corr.size());
@@ -270,7 +281,9 @@ MatchResult matchClass(const LandmarkModel& model, const FrameFeatures& frame, c
     if (tried >= p.max_photos) break;
     ++tried;
     MatchResult r = verifyPhoto(model, frame, q, ph, p);
-    if (r.inliers > best.inliers || best.database_photo < 0) best = std::move(r);
+    if (std::make_pair(r.matched, r.inliers) > std::make_pair(best.matched, best.inliers) ||
+        best.database_photo < 0)
+      best = std::move(r);
     if (best.matched && best.inliers >= p.strong_inliers) break;
   }
   best.photos_tried = tried;
@@ -290,6 +303,16 @@ MatchResult match(const LandmarkModel& model, const FrameFeatures& frame, const 
                   const std::string& target_class, const MatchParams& params) {
   const int cls = model.classId(target_class);
   if (cls < 0) throw InputError("landmark class '" + target_class + "' is not in the model");
+  const cv::Rect win =
+      window.area() > 0 ? window : cv::Rect(cv::Point(), frame.features.image_size);
+  if (frame.photo_cache) {
+    // recognise() already verified this class here with the same settings: reuse it.
+    std::lock_guard<std::mutex> lock(frame.photo_cache->mutex);
+    for (const auto& v : frame.photo_cache->verified)
+      if (v.model == &model && v.class_id == cls && v.window == win &&
+          sameVerification(v.params, params))
+        return v.result;
+  }
   const auto idx = detail::keypointsInWindow(frame, window);
   MatchResult r;
   if (static_cast<int>(idx.size()) >= params.min_window_features) {
@@ -297,7 +320,7 @@ MatchResult match(const LandmarkModel& model, const FrameFeatures& frame, const 
     r = detail::matchClass(model, frame, q, cls, detail::photoSimilarities(model, q.histogram),
                            params);
   }
-  r.window = window.area() > 0 ? window : cv::Rect(cv::Point(), frame.features.image_size);
+  r.window = win;
   return r;
 }
 

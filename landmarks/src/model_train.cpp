@@ -1,7 +1,9 @@
 // Training a landmark model from a folder of class folders.
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <mutex>
 
@@ -24,6 +26,8 @@ void ModelParams::validate() const {
   require(frame_max_features >= 0, "train.frame_max_features", "must be >= 0");
   require(frame_max_image_side >= 64, "train.frame_max_image_side", "must be >= 64 px");
   require(seed >= 0, "train.seed", "must be >= 0");
+  require(synth_views >= 0 && synth_views <= 4, "train.synth_views", "must be in [0, 4]");
+  require(synth_tilt > 1 && synth_tilt <= 4, "train.synth_tilt", "must be in (1, 4]");
 }
 
 std::string landmarkSetFingerprint(const std::string& landmark_dir) {
@@ -39,6 +43,55 @@ std::string landmarkSetFingerprint(const std::string& landmark_dir) {
                 static_cast<unsigned long long>(detail::fnv1a(text.data(), text.size())));
   return buf;
 }
+
+namespace {
+
+// ASIFT-like view synthesis: the photo seen obliquely, as an affine tilt (anti-aliased
+// compression along one axis); the views' keypoints are mapped back into the photo's pixels so
+// they verify against frames like the photo's own.
+void addSynthesisedViews(const cv::Mat& img, const ModelParams& p, std::vector<cv::KeyPoint>& kps,
+                         cv::Mat& sift_u8) {
+  const double t = p.synth_tilt;
+  const double sigma = 0.8 * std::sqrt(t * t - 1);  // Morel & Yu's anti-aliasing for a tilt t
+  for (int v = 0; v < p.synth_views; ++v) {
+    // Views 0, 1: compressed along x, along y; 2, 3: the same along the diagonals.
+    const double a = (v % 2 == 0 ? 0.0 : 90.0) + (v >= 2 ? 45.0 : 0.0);
+    const cv::Point2f c(0.5f * img.cols, 0.5f * img.rows);
+    cv::Mat R = cv::getRotationMatrix2D(c, a, 1.0);  // rotate, compress x, rotate back
+    cv::Mat rot;
+    cv::warpAffine(img, rot, R, img.size(), cv::INTER_LINEAR, cv::BORDER_REPLICATE);
+    cv::Mat blurred, tilted;
+    cv::GaussianBlur(rot, blurred, cv::Size(0, 0), sigma, 0.01);
+    cv::resize(blurred, tilted, cv::Size(), 1.0 / t, 1.0, cv::INTER_LINEAR);
+    std::vector<cv::KeyPoint> vk;
+    cv::Mat vd;
+    detectSift(tilted, p.features, vk, vd);
+    if (vk.empty()) continue;
+    // Back: un-compress x, then the inverse rotation.
+    cv::Mat Ri;
+    cv::invertAffineTransform(R, Ri);
+    std::vector<cv::Point2f> pts;
+    for (const auto& k : vk) pts.push_back({static_cast<float>(k.pt.x * t), k.pt.y});
+    cv::transform(pts, pts, Ri);
+    cv::Mat keep_rows;
+    for (size_t i = 0; i < vk.size(); ++i) {
+      if (pts[i].x < 0 || pts[i].y < 0 || pts[i].x >= img.cols || pts[i].y >= img.rows) continue;
+      cv::KeyPoint k = vk[i];
+      k.pt = pts[i];
+      k.size = static_cast<float>(k.size * std::sqrt(t));  // geometric mean of the two scales
+      kps.push_back(k);
+      keep_rows.push_back(vd.row(static_cast<int>(i)));
+    }
+    if (!keep_rows.empty()) {
+      if (sift_u8.empty())
+        sift_u8 = keep_rows;
+      else
+        cv::vconcat(sift_u8, keep_rows, sift_u8);
+    }
+  }
+}
+
+}  // namespace
 
 LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& params,
                          const TrainProgress& progress, const std::vector<std::string>& exclude) {
@@ -80,6 +133,7 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
     ph.path = fs::relative(items[i].path, set.root).string();
     ph.size = img.size();
     detectSift(img, params.features, ph.keypoints, ph.sift_u8);
+    addSynthesisedViews(img, params, ph.keypoints, ph.sift_u8);
     ph.colours = keypointColours(img, ph.keypoints);
     if (ph.keypoints.size() < 5) {
       log::warn("landmarks", "skipping photo with too little texture",

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cmath>
 #include <numeric>
 #include <set>
 #include <tuple>
@@ -21,7 +22,36 @@ void RecognitionParams::validate() const {
   match.validate();
 }
 
+double RecognitionParams::combinedScore(int inliers, int votes, int total_votes, double bow_p,
+                                        bool verified) const {
+  const double vote_share = total_votes > 0 ? static_cast<double>(votes) / total_votes : 0.0;
+  return score_bias + score_inliers * std::log1p(inliers) + score_vote_share * vote_share +
+         score_votes * std::log1p(votes) + score_bow * bow_p + (verified ? score_verified : 0.0);
+}
+
 namespace {
+
+// What recognise() learnt about one class in one window.
+struct Evidence {
+  int inliers = 0;       // best photo's RANSAC inliers, also below min_inliers
+  int vote_inliers = 0;  // the same on the vote correspondences only (distinctive matches)
+  bool verified = false;
+  bool tried = false;
+  float confidence = 0;
+  MatchResult best;
+};
+
+// Keeps the verification of the answer in the frame's cache, so match() on the same frame,
+// window and class (the servo, right after recognition) does not search the photos again.
+void remember(const FrameFeatures& frame, const LandmarkModel& model, const cv::Rect& win,
+              const std::string& cls, const std::vector<Evidence>& ev, const RecognitionParams& p) {
+  const int c = model.classId(cls);
+  if (c < 0 || !ev[c].verified || !frame.photo_cache) return;
+  std::lock_guard<std::mutex> lock(frame.photo_cache->mutex);
+  MatchResult m = ev[c].best;
+  m.window = win;
+  frame.photo_cache->verified.push_back({&model, c, win, p.match, std::move(m)});
+}
 
 std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const FrameFeatures& frame,
                                          const cv::Rect& window, int top_k,
@@ -73,19 +103,22 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
     }
   }
 
-  // Verification in ranking order. Ranked by votes, the first class that verifies is the
-  // answer, so the rest need not be verified (lazy: most frames verify 1-3 photos instead of
-  // up to shortlist x max_photos); ranked by inliers, every shortlisted class is verified.
-  if (p.rank_by_votes)
+  // Verification in ranking order (votes, then BoW).
+  if (p.rank_by_votes || p.combined_score)
     std::stable_sort(shortlist.begin(), shortlist.end(), [&](int a, int b) {
       return std::make_pair(votes.class_votes[a], prob[a]) >
              std::make_pair(votes.class_votes[b], prob[b]);
     });
-  std::vector<std::pair<int, int>> verified;  // (inliers, class)
-  std::vector<float> conf(n_classes, 0.0f);
+  std::vector<Evidence> ev(n_classes);
   int budget = p.max_verified_photos > 0 ? p.max_verified_photos : 1 << 30;
+  bool any_verified = false;
   for (int c : shortlist) {
-    if (budget <= 0 || (p.rank_by_votes && !verified.empty())) break;
+    // Old rule, ranked by votes: the first class that verifies is the answer, so the rest need
+    // not be verified. Combined score: every shortlisted class gets at least one photo (its
+    // inlier count is evidence even below min_inliers), later classes only while the budget
+    // lasts.
+    if (budget <= 0) break;
+    if (!p.combined_score && p.rank_by_votes && any_verified) break;
     // The class's photos with the most tentative correspondences first.
     std::vector<int> photos = model.photosOfClass(c);
     std::stable_sort(photos.begin(), photos.end(), [&](int a, int b) {
@@ -97,25 +130,74 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
     const std::vector<int>& rows = votes.class_rows[c];
     if (p.class_rows && static_cast<int>(rows.size()) < p.match.min_inliers) continue;
     const detail::WindowQuery cq = p.class_rows ? detail::subQuery(q, rows) : detail::WindowQuery();
+    ev[c].tried = true;
     for (int i = 0; i < std::min<int>(p.match.max_photos, static_cast<int>(photos.size())); ++i) {
       if (budget-- <= 0) break;
       const int ph = photos[i];
       // Cascade: RANSAC on the vote search's correspondences costs ~0.2 ms and settles most
       // clear views; only when it does not verify is the photo searched exhaustively.
       MatchResult m;
-      if (p.vote_correspondences || p.votes_first)
+      if (p.vote_correspondences || p.votes_first || p.combined_score) {
         m = detail::ransacPhoto(model, frame, q, ph, votes.photo_corr[ph], p.match);
+        ev[c].vote_inliers = std::max(ev[c].vote_inliers, m.inliers);
+      }
       if (!p.vote_correspondences && !m.matched)
         m = detail::verifyPhoto(model, frame, p.class_rows ? cq : q, ph, p.match);
-      if (m.inliers > best.inliers) best = std::move(m);
+      if (std::make_pair(m.matched, m.inliers) > std::make_pair(best.matched, best.inliers))
+        best = std::move(m);
       if (best.matched && best.inliers >= p.match.strong_inliers) break;
+      // A class far below min_inliers on its most promising photo rarely does better on the
+      // next ones: with the combined score, spend the budget on the other candidates.
+      if (p.combined_score && best.inliers < p.match.min_inliers / 2) break;
     }
-    if (best.matched) {
-      verified.push_back({best.inliers, c});
-      conf[c] = best.confidence;
-    }
+    ev[c].inliers = best.inliers;
+    ev[c].verified = best.matched;
+    ev[c].confidence = best.confidence;
+    any_verified = any_verified || best.matched;
+    ev[c].best = std::move(best);
   }
-  // Verified classes, best first: by votes (or inliers), ties by the other, then by BoW.
+
+  int total_votes = 0;
+  for (int v : votes.class_votes) total_votes += v;
+  auto evidence = [&](int c) {
+    return static_cast<float>(
+        p.combinedScore(ev[c].inliers, votes.class_votes[c], total_votes, prob[c], ev[c].verified));
+  };
+  auto make = [&](int c) {
+    Recognition r = entry(c);
+    r.inliers = ev[c].inliers;
+    r.vote_inliers = ev[c].vote_inliers;
+    r.verified = ev[c].verified;
+    r.votes = votes.class_votes[c];
+    r.score = ev[c].confidence;
+    r.evidence = evidence(c);
+    r.vote_share = total_votes > 0 ? static_cast<float>(votes.class_votes[c]) / total_votes : 0.0f;
+    return r;
+  };
+
+  if (p.combined_score) {
+    // One score per candidate from all the evidence; the best candidate is the answer when its
+    // score reaches accept_score, whether or not it reached min_inliers; otherwise none.
+    std::vector<int> cand = shortlist;
+    for (int c : order)  // then the other classes, for a full top-k list
+      if (std::find(cand.begin(), cand.end(), c) == cand.end()) cand.push_back(c);
+    std::vector<float> s(n_classes);
+    for (int c : cand) s[c] = evidence(c);
+    std::stable_sort(cand.begin(), cand.end(), [&](int a, int b) { return s[a] > s[b]; });
+    for (int c : cand) {
+      if (static_cast<int>(out.size()) >= top_k) break;
+      out.push_back(make(c));
+    }
+    const bool reject = out.empty() || out.front().evidence < p.accept_score;
+    for (size_t i = 0; i < out.size(); ++i) out[i].rejected = reject || i > 0;
+    if (!out.empty() && !reject) remember(frame, model, win, out.front().class_name, ev, p);
+    return out;
+  }
+
+  // Old rule: verified classes, best first: by votes (or inliers), ties by the other, then BoW.
+  std::vector<std::pair<int, int>> verified;  // (inliers, class)
+  for (int c = 0; c < n_classes; ++c)
+    if (ev[c].verified) verified.push_back({ev[c].inliers, c});
   auto key = [&](const std::pair<int, int>& v) {
     const int votes_c = votes.class_votes[v.second];
     return p.rank_by_votes ? std::make_tuple(votes_c, v.first, prob[v.second])
@@ -126,11 +208,7 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   std::set<int> used;
   for (const auto& [inl, c] : verified) {
     if (static_cast<int>(out.size()) >= top_k) break;
-    Recognition r = entry(c);
-    r.inliers = inl;
-    r.votes = votes.class_votes[c];
-    r.score = conf[c];
-    out.push_back(r);
+    out.push_back(make(c));
     used.insert(c);
   }
   const bool none = verified.empty();
@@ -142,13 +220,13 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   for (int c : rest) {
     if (static_cast<int>(out.size()) >= top_k) break;
     if (used.count(c)) continue;
-    Recognition r = entry(c);
-    r.votes = votes.class_votes[c];
+    Recognition r = make(c);
     r.rejected = true;  // not verified: a candidate only
     out.push_back(r);
   }
   if (none)
     for (auto& r : out) r.rejected = true;
+  if (!none) remember(frame, model, win, out.front().class_name, ev, p);
   return out;
 }
 
@@ -183,8 +261,10 @@ std::vector<Recognition> recognise(const LandmarkModel& model, const FrameFeatur
     all.insert(all.end(), v.begin(), v.end());
   // Best first: accepted before rejected, then the same order as within a window.
   auto key = [&](const Recognition& r) {
-    return p.rank_by_votes ? std::make_tuple(!r.rejected, r.votes, r.inliers, r.score)
-                           : std::make_tuple(!r.rejected, r.inliers, r.votes, r.score);
+    if (p.combined_score) return std::make_tuple(!r.rejected, r.evidence, 0, 0.0f);
+    return p.rank_by_votes
+               ? std::make_tuple(!r.rejected, static_cast<float>(r.votes), r.inliers, r.score)
+               : std::make_tuple(!r.rejected, static_cast<float>(r.inliers), r.votes, r.score);
   };
   std::stable_sort(all.begin(), all.end(),
                    [&](const Recognition& a, const Recognition& b) { return key(a) > key(b); });

@@ -5,6 +5,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/matcher.h"
 #include "sketchnav/landmarks/model.h"
+#include "sketchnav/landmarks/recognition.h"
 #include "test_data.h"
 #include "test_recognition_support.h"
 
@@ -109,6 +110,86 @@ TEST_F(MatchFixture, WrongClassOrEmptyWindowIsNotMatched) {
   const MatchResult off = match(*model_, frame, cv::Rect(0, 0, 40, 40), "class0", MatchParams{});
   EXPECT_FALSE(off.matched);
   EXPECT_THROW(match(*model_, frame, cv::Rect(), "no-such-class", MatchParams{}), InputError);
+}
+
+TEST_F(MatchFixture, MatchReusesRecognitionsVerificationOfTheSameFrame) {
+  const cv::Mat H = similarity(20, 0.9, 40, 10);
+  const FrameFeatures f = computeFrameFeatures(*model_, frameWith(H));
+  RecognitionParams rp;
+  const auto r = recognise(*model_, f, {}, 1, rp);
+  ASSERT_FALSE(r.empty());
+  ASSERT_FALSE(r[0].rejected);
+  ASSERT_EQ(r[0].class_name, "class0");
+  ASSERT_EQ(f.photo_cache->verified.size(), 1u);
+  const MatchResult fresh =
+      match(*model_, FrameFeatures{f.features, f.words, nullptr}, cv::Rect(), "class0", rp.match);
+  const MatchResult reused = match(*model_, f, cv::Rect(), "class0", rp.match);
+  checkRecovered(H, reused);
+  EXPECT_EQ(reused.inliers, r[0].inliers);
+  EXPECT_EQ(reused.database_photo, fresh.database_photo);
+  EXPECT_EQ(reused.window, cv::Rect(0, 0, 640, 480));
+  // It is the cached verification (marked here), not a new search; other verification settings
+  // or another class search afresh.
+  f.photo_cache->verified[0].result.inliers = 999;
+  EXPECT_EQ(match(*model_, f, cv::Rect(), "class0", rp.match).inliers, 999);
+  MatchParams other = rp.match;
+  other.min_inliers += 1;
+  EXPECT_EQ(match(*model_, f, cv::Rect(), "class0", other).inliers, fresh.inliers);
+  EXPECT_FALSE(match(*model_, f, cv::Rect(), "class1", rp.match).matched);
+}
+
+TEST(ViewSynthesis, MoreInliersOnAStronglyTiltedView) {
+  // One flat photo; the frame sees it at ~70 degrees off its normal (compressed 3x along x).
+  const std::string root = test::tempDir("recog-synth");
+  std::filesystem::create_directories(root + "/class0");
+  std::filesystem::create_directories(root + "/class1");
+  cv::imwrite(root + "/class0/flat.png", test::texturedImage(320, 240, 1000));
+  cv::imwrite(root + "/class1/flat.png", test::texturedImage(320, 240, 1001));
+  ModelParams p;
+  p.vocabulary_size = 50;
+  const LandmarkModel plain = trainModel(root, p);
+  p.synth_views = 2;
+  p.synth_tilt = 2.0;
+  const LandmarkModel synth = trainModel(root, p);
+  // Database keypoints of the synthesised views are in the photo's pixels.
+  const auto& ph = synth.photos()[synth.photosOfClass(0)[0]];
+  EXPECT_GT(ph.keypoints.size(), plain.photos()[plain.photosOfClass(0)[0]].keypoints.size());
+  for (const auto& k : ph.keypoints) {
+    EXPECT_GE(k.pt.x, 0);
+    EXPECT_LT(k.pt.x, 320);
+  }
+  int plain_sum = 0, synth_sum = 0;
+  for (int i = 0; i < 3; ++i) {
+    cv::Mat H = (cv::Mat_<double>(3, 3) << 1.0 / 3, 0.05 * i, 260, 0.1, 1.2, 80 + 20 * i, 0, 0, 1);
+    if (i == 2) H = (cv::Mat_<double>(3, 3) << 1.2, 0, 140, 0.05, 0.4, 150, 0, 0, 1);  // along y
+    cv::Mat frame(480, 640, CV_8UC3);
+    cv::RNG(3 + i).fill(frame, cv::RNG::UNIFORM, 90, 160);
+    cv::GaussianBlur(frame, frame, cv::Size(0, 0), 4);
+    cv::warpPerspective(test::texturedImage(320, 240, 1000), frame, H, frame.size(), cv::INTER_AREA,
+                        cv::BORDER_TRANSPARENT);
+    MatchParams mp;
+    mp.min_inliers = 8;
+    const MatchResult a = match(plain, frame, cv::Rect(), "class0", mp);
+    const MatchResult b = match(synth, frame, cv::Rect(), "class0", mp);
+    plain_sum += a.inliers;
+    synth_sum += b.inliers;
+    // The synthesised view's correspondences agree with the true warp.
+    if (b.matched) {
+      std::vector<cv::Point2f> proj;
+      cv::perspectiveTransform(b.x_d, proj, H);
+      int close = 0;
+      for (size_t k = 0; k < proj.size(); ++k) close += cv::norm(proj[k] - b.x_t[k]) < 8.0;
+      EXPECT_GE(close, static_cast<int>(0.9 * proj.size()));
+    }
+  }
+  EXPECT_GT(synth_sum, plain_sum + plain_sum / 2 + 10);
+  EXPECT_THROW(
+      [] {
+        ModelParams bad;
+        bad.synth_views = 5;
+        bad.validate();
+      }(),
+      InputError);
 }
 
 TEST(MatchPhotoOrder, TheSmallObjectsPhotoIsTriedFirstInAClutteredFrame) {

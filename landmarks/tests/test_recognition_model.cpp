@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 
@@ -152,6 +153,64 @@ TEST_F(TinyModel, RecognisesHeldOutViewsAndRejectsUnknownObjects) {
     rejected += r.empty() || r[0].rejected;
   }
   EXPECT_EQ(rejected, 3);
+}
+
+TEST_F(TinyModel, CombinedScoreRanksByAllEvidenceAndRejectsBelowTheThreshold) {
+  RecognitionParams p;
+  p.combined_score = true;
+  int correct = 0;
+  for (int k = 0; k < 3; ++k)
+    for (int i = 0; i < 3; ++i) {
+      const cv::Mat view = test::randomView(test::texturedImage(240, 180, 1000 + k), 320, 240,
+                                            5000 + 10 * k + i, 20);
+      const auto r = recognise(*model_, view, {}, 3, p);
+      ASSERT_GE(r.size(), 2u);
+      correct += !r[0].rejected && r[0].class_name == "class" + std::to_string(k);
+      // Best first by the combined score, which is what the evidence fields give.
+      EXPECT_GE(r[0].evidence, r[1].evidence);
+      EXPECT_NEAR(
+          r[0].evidence,
+          p.combinedScore(
+              r[0].inliers, r[0].votes,
+              r[0].vote_share > 0 ? static_cast<int>(std::lround(r[0].votes / r[0].vote_share)) : 0,
+              r[0].bow_probability, r[0].verified),
+          1e-3);
+      EXPECT_TRUE(r[1].rejected);  // only the best candidate can be the answer
+    }
+  EXPECT_GE(correct, 8) << "of 9 held-out views";
+  // Unknown objects score low; a threshold between them and the known views rejects them all,
+  // and a threshold below everything accepts them (so the threshold is what decides).
+  RecognitionParams lax = p;
+  lax.accept_score = -1e9;
+  p.accept_score = 3;  // known views score 7-8 here, unknown objects about 0
+  for (int i = 0; i < 3; ++i) {
+    const cv::Mat unknown =
+        test::randomView(test::texturedImage(240, 180, 7777 + i), 320, 240, 6000 + i, 20);
+    const auto r = recognise(*model_, unknown, {}, 3, p);
+    ASSERT_FALSE(r.empty());
+    EXPECT_TRUE(r[0].rejected) << "evidence " << r[0].evidence;
+    EXPECT_FALSE(recognise(*model_, unknown, {}, 3, lax)[0].rejected);
+  }
+}
+
+TEST_F(TinyModel, InlierEvidenceIsReportedBelowMinInliers) {
+  // An unknown object: candidates are not verified, but the inliers found are still reported
+  // (the combined score uses them), and 'verified' is what says they are too few.
+  const cv::Mat unknown = test::randomView(test::texturedImage(240, 180, 7777), 320, 240, 6000, 20);
+  RecognitionParams p;
+  p.max_verified_photos = 0;
+  const auto r = recognise(*model_, unknown, {}, 3, p);
+  ASSERT_FALSE(r.empty());
+  for (const auto& c : r) {
+    EXPECT_FALSE(c.verified);
+    EXPECT_LT(c.inliers, p.match.min_inliers);
+  }
+  // A known view: the answer is verified with at least min_inliers.
+  const cv::Mat view = test::randomView(test::texturedImage(240, 180, 1001), 320, 240, 5011, 20);
+  const auto k = recognise(*model_, view, {}, 3, p);
+  ASSERT_FALSE(k.empty());
+  EXPECT_TRUE(k[0].verified);
+  EXPECT_GE(k[0].inliers, p.match.min_inliers);
 }
 
 TEST_F(TinyModel, WindowsRestrictTheSearch) {

@@ -72,10 +72,15 @@ struct FrameFeatures {
   struct PhotoCache;
   std::shared_ptr<PhotoCache> photo_cache = std::make_shared<PhotoCache>();
 };
+struct MatchResult;
 struct FrameFeatures::PhotoCache {
   std::mutex mutex;
   // (model, class, checks) -> nearest photo per keypoint
   std::map<std::tuple<const void*, int, int>, std::vector<int>> nearest;
+  // recognise()'s verification of its answer per window, reused by match() with the same
+  // window, class and verification settings (recognise + match per frame: one search, not two).
+  struct Verified;
+  std::vector<Verified> verified;
 };
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr);
 /// Same with explicit feature settings for the frame (e.g. a camera frame kept at full
@@ -100,9 +105,19 @@ struct MatchResult {
   int wrong_colour = 0;  // correspondences consistent with H but of another colour (not inliers)
 };
 
+struct FrameFeatures::PhotoCache::Verified {
+  const void* model;
+  int class_id;
+  cv::Rect window;
+  MatchParams params;
+  MatchResult result;
+};
+
 /// Matches the window's keypoints against the target class's database photos (the most
 /// promising max_photos, see photo_order_checks): ratio test, colour check, then RANSAC
 /// homography; the photo with the most inliers wins. An empty window means the whole frame.
+/// When recognise() on the same FrameFeatures verified this class in this window with the same
+/// ratio / min_inliers / RANSAC / colour settings, its verification is returned (no search).
 /// Unknown class -> InputError.
 MatchResult match(const LandmarkModel& model, const FrameFeatures& frame, const cv::Rect& window,
                   const std::string& target_class, const MatchParams& params);

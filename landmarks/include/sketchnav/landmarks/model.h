@@ -24,8 +24,14 @@ struct ModelParams {
   // database keypoints are paid once, at training time.
   int frame_max_features = 500;    // keypoints kept per frame (strongest); 0 = all
   int frame_max_image_side = 400;  // [px] longer frame side above this is downscaled for SIFT
-  int vocabulary_size = 1000;      // visual words; capped at training descriptors / 10
-  int kmeans_sample = 60000;       // descriptors sampled for k-means
+  // View synthesis (ASIFT-like): besides the photo itself, SIFT on `synth_views` affine-tilted
+  // copies (compressed by synth_tilt along x, then along y, ...), keypoints mapped back to the
+  // photo's pixels, up to features.max_features per view. More database keypoints for oblique
+  // views of the package; 0 = off.
+  int synth_views = 0;
+  double synth_tilt = 2.0;
+  int vocabulary_size = 1000;  // visual words; capped at training descriptors / 10
+  int kmeans_sample = 60000;   // descriptors sampled for k-means
   int kmeans_iterations = 8;
   double svm_c = 1.0;  // linear SVM soft-margin constant
   int seed = 1;        // descriptor sampling, k-means seeding, CV folds
@@ -38,6 +44,8 @@ struct ModelParams {
     b("root_sift", features.root_sift);
     b("frame_max_features", frame_max_features);
     b("frame_max_image_side", frame_max_image_side);
+    b("synth_views", synth_views);
+    b("synth_tilt", synth_tilt);
     b("vocabulary_size", vocabulary_size);
     b("kmeans_sample", kmeans_sample);
     b("kmeans_iterations", kmeans_iterations);

@@ -14,6 +14,10 @@
 //   at the first class that verifies, under a budget of max_verified_photos; a photo is
 //   first verified with the vote search's correspondences (one RANSAC, ~0.2 ms) and searched
 //   exhaustively only when that fails. Before: up to 15 exhaustive photo searches per frame.
+//   The verification of the answer is left in the FrameFeatures for match() (the servo's
+//   per-frame call), which returns it instead of searching the class's photos again.
+// - the decision: measured, a combined evidence score (combined_score) is no better than "the
+//   first class by votes that verifies": the evidence, not the rule, limits accuracy.
 #include <opencv2/core.hpp>
 
 #include <string>
@@ -43,7 +47,22 @@ struct RecognitionParams {
                                 // a frame of no known object tries every candidate); 0 = no limit
   bool verify = true;           // false = plain BoW + SVM (for comparisons)
   double reject_probability = 0.2;  // BoW-only mode: best calibrated p below -> rejected
-  MatchParams match;                // verification settings (min_inliers is the reject threshold)
+  // Decision. false (default): the first class by votes that reaches min_inliers, else "none of
+  // these". true: one score per shortlisted class from all its evidence (combinedScore()), the
+  // best-scoring class is the answer when its score reaches accept_score, verified or not.
+  // Measured no better on grocery val (doc/landmark-model.md): siblings share artwork, so no mix
+  // of votes, inliers and SVM separates them much better than votes alone. Weights: logistic
+  // regression on held-out train photos (bench/recognition/calibrate.sh).
+  bool combined_score = false;
+  double score_bias = -8.6;
+  double score_inliers = 0.09;     // × ln(1 + inliers of the best photo, also < min_inliers)
+  double score_vote_share = 10.9;  // × the class's share of all votes of the window
+  double score_votes = 0.94;       // × ln(1 + votes)
+  double score_bow = 1.5;          // × calibrated SVM probability
+  double score_verified = -0.7;    // + when the class reached min_inliers (colour-checked)
+  double accept_score = -4.0;  // log-odds; the best class below it -> "none of these" (chosen on
+                               // val: the old rule's top-1; held-out train photos suggest ~0)
+  MatchParams match;           // verification settings (min_inliers is the reject threshold)
 
   template <class B>
   void bind(B& b) {
@@ -59,6 +78,14 @@ struct RecognitionParams {
     b("max_verified_photos", max_verified_photos);
     b("verify", verify);
     b("reject_probability", reject_probability);
+    b("combined_score", combined_score);
+    b("score_bias", score_bias);
+    b("score_inliers", score_inliers);
+    b("score_vote_share", score_vote_share);
+    b("score_votes", score_votes);
+    b("score_bow", score_bow);
+    b("score_verified", score_verified);
+    b("accept_score", accept_score);
     b("ratio", match.ratio);
     b("min_inliers", match.min_inliers);
     b("ransac_px", match.ransac_px);
@@ -70,15 +97,23 @@ struct RecognitionParams {
     b("colour_min_fraction", match.colour_min_fraction);
   }
   void validate() const;
+  /// The combined evidence score (log-odds that the class is the one in the window).
+  double combinedScore(int inliers, int votes, int total_votes, double bow_p, bool verified) const;
 };
 
 struct Recognition {
   std::string class_name;
   float score = 0;  // verified: match confidence in [0,1); BoW-only: calibrated p
   float bow_probability = 0;
-  int inliers = 0;  // RANSAC inliers against the best database photo (0 = not verified)
-  int votes = 0;    // window descriptors whose nearest database neighbour (ratio-tested
-                    // against other classes) belongs to this class
+  int inliers = 0;        // RANSAC inliers against the best database photo tried (0 = not tried);
+                          // may be below min_inliers (see verified)
+  int vote_inliers = 0;   // RANSAC inliers among the vote correspondences only (matches that
+                          // passed the ratio test between classes: what siblings do not share)
+  bool verified = false;  // inliers >= min_inliers and the colour check passed
+  float evidence = 0;     // RecognitionParams::combinedScore() (log-odds)
+  float vote_share = 0;   // votes / all votes of the window
+  int votes = 0;          // window descriptors whose nearest database neighbour (ratio-tested
+                          // against other classes) belongs to this class
   cv::Rect window;
   bool rejected = false;  // no candidate verified (or p below threshold in BoW-only mode)
 };
