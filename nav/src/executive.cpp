@@ -610,6 +610,13 @@ struct Executive::Impl {
                {"original_heading_deg", av.original_heading * 180 / M_PI},
                {"front_free_m", av.front_free_m},
                {"section", k}});
+        // Dodging something right at the landmark being servoed on: it stands on or against
+        // that furniture, and this is as close as the robot gets. Passing it now keeps the
+        // servo from steering back into the furniture after the dodge (a robot circled the
+        // lab bench its landmark was on).
+        if (tr && lm && tr->state == LmState::Tracking && tr->last_range > 0 &&
+            tr->last_range <= passDistance(att[0].k, *lm) + 1.0)
+          passLandmark(att[0].k, att[0].i, false);
       }
       if (av.ended) event({{"type", "avoid_end"}, {"side", toString(av.side)}});
       if (av.active) {

@@ -20,6 +20,8 @@ void LaserOdometryParams::validate() const {
   require(keyframe_deg > 0 && keyframe_deg <= 90, "nav.laser_odometry.keyframe_deg",
           "must be in (0, 90]");
   require(max_range_m > 0, "nav.laser_odometry.max_range_m", "must be > 0");
+  require(submap_keyframes >= 1 && submap_keyframes <= 20, "nav.laser_odometry.submap_keyframes",
+          "must be in [1, 20]");
   require(min_points >= 5, "nav.laser_odometry.min_points", "must be >= 5");
   require(min_spread_m >= 0, "nav.laser_odometry.min_spread_m", "must be >= 0");
   require(min_goodness >= 0 && min_goodness <= 1, "nav.laser_odometry.min_goodness",
@@ -47,8 +49,13 @@ struct LaserOdometry::Impl {
   bool have_anchor = false;
   CPose2D anchor_wheel, anchor_pose;  // a wheel pose and the corrected pose at that moment
   bool have_kf = false;
-  CPose2D kf_pose;
-  mrpt::maps::CSimplePointsMap kf_map;
+  CPose2D kf_pose;                      // the newest keyframe's pose
+  mrpt::maps::CSimplePointsMap kf_map;  // the last keyframes' points, in the newest's frame
+  struct Keyframe {
+    CPose2D pose;
+    std::vector<float> xs, ys;  // scan points in the robot frame at `pose`
+  };
+  std::deque<Keyframe> keyframes;  // the submap, oldest first
   double last_scan_stamp = -1e300;
   double ms_sum = 0;
 
@@ -157,9 +164,25 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   CPose2D wheel_s;
   I.wheelAt(sc.stamp, wheel_s);
   const CPose2D predicted = I.corrected(wheel_s);
+  // The reference is the union of the last submap_keyframes keyframes, expressed in the newest
+  // one's frame: a new keyframe is then placed against points seen from several earlier poses
+  // rather than one, so its error is not simply added to the previous keyframe's.
   auto newKeyframe = [&](const CPose2D& at) {
+    Impl::Keyframe k;
+    k.pose = at;
+    k.xs.assign(cur.getPointsBufferRef_x().begin(), cur.getPointsBufferRef_x().end());
+    k.ys.assign(cur.getPointsBufferRef_y().begin(), cur.getPointsBufferRef_y().end());
+    I.keyframes.push_back(std::move(k));
+    while (static_cast<int>(I.keyframes.size()) > params_.submap_keyframes) I.keyframes.pop_front();
     I.kf_pose = at;
-    I.kf_map = cur;
+    I.kf_map.clear();
+    for (const auto& kf : I.keyframes) {
+      const CPose2D rel = kf.pose - at;  // that keyframe in the newest one's frame
+      const double c = std::cos(rel.phi()), sn = std::sin(rel.phi());
+      for (size_t i = 0; i < kf.xs.size(); ++i)
+        I.kf_map.insertPoint(static_cast<float>(rel.x() + c * kf.xs[i] - sn * kf.ys[i]),
+                             static_cast<float>(rel.y() + sn * kf.xs[i] + c * kf.ys[i]), 0.f);
+    }
     I.have_kf = true;
     ++stats_.keyframes;
   };

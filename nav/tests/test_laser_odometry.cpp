@@ -66,10 +66,10 @@ struct Result {
 // Drives a 6 x 3 m rectangle round the table (straight at 0.3 m/s, 90 deg turns on the spot at
 // 0.6 rad/s) for `seconds`; the wheel odometry turns `drift` rad per metre too much (a
 // wheel-radius mismatch). Errors are at the end.
-Result drive(double drift, double seconds, bool with_laser, unsigned seed) {
+Result drive(double drift, double seconds, bool with_laser, unsigned seed,
+             LaserOdometryParams p = {}) {
   std::mt19937 rng(seed);
   const auto segs = room();
-  LaserOdometryParams p;
   LaserOdometry lo(p);
   hw::Pose2D truth{1.5, 1.2, 0}, wheel{0, 0, 0};
   const double dt = 0.05, v = 0.3, w_turn = 0.6;
@@ -160,5 +160,8 @@ TEST(LaserOdometry, ValidatesItsSettings) {
   EXPECT_THROW(LaserOdometry{p}, InputError);
   p = {};
   p.keyframe_dist_m = 0;
+  EXPECT_THROW(LaserOdometry{p}, InputError);
+  p = {};
+  p.submap_keyframes = 0;
   EXPECT_THROW(LaserOdometry{p}, InputError);
 }
