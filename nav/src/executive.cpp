@@ -178,6 +178,7 @@ struct Executive::Impl {
   double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
+  std::vector<std::vector<Sighting>> fixes_rays;         // their sightings (none: the start)
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -746,6 +747,7 @@ struct Executive::Impl {
       const Eigen::Vector2d shift = seen - tracker.toOdom(lm.position_m);
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
+      fixes_rays.push_back(tr.sightings);
       // With enough fixes spread far enough: refit rotation, scale and translation to the
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
       // part of the way to this one (hand-drawn maps are also locally distorted).
@@ -756,8 +758,25 @@ struct Executive::Impl {
       for (const auto& a : fr)
         for (const auto& b : fr) span = std::max(span, (a - b).norm());
       if (n >= 3 && span >= s.exec.fit_min_span_m) {
-        const auto f =
-            tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
+        SectionTracker::Fit f;
+        if (s.exec.fit_rays) {
+          RayFitParams rp;
+          rp.bearing_sigma_deg = s.locate.bearing_sigma_deg;
+          rp.outlier_m = s.exec.fit_outlier_m;
+          rp.max_scale_change = s.exec.fit_max_scale_change;
+          std::vector<RayFix> rf;
+          for (size_t j = fixes_route.size() - n; j < fixes_route.size(); ++j) {
+            RayFix x;
+            x.route_pt = fixes_route[j];
+            x.is_point = fixes_rays[j].empty();
+            x.odom_pt = fixes_odom[j];
+            x.rays = fixes_rays[j];
+            rf.push_back(std::move(x));
+          }
+          f = tracker.fitSimilarityRays(rf, rp);
+        } else {
+          f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
+        }
         // Not towards the newest fix when the fit found it an outlier.
         if (f.used.empty() || f.used.back())
           tracker.reanchor(lm.position_m, seen, s.exec.fit_local_gain);
@@ -826,6 +845,7 @@ void Executive::start() {
   I.fix_odom = I.tracker.toOdom(I.fix_route);
   I.fixes_route = {I.fix_route};
   I.fixes_odom = {I.fix_odom};
+  I.fixes_rays = {{}};
   I.safety.start(I.t0);
   I.status = RunStatus::Running;
   I.event({{"type", "start"},

@@ -177,3 +177,80 @@ TEST(SectionTracker, FitSimilarityLeavesOutAFixFarOffTheOthers) {
   EXPECT_LT((robust.toOdom(goal) - truth).norm(), 1e-9);
   EXPECT_GT((kept.toOdom(goal) - truth).norm(), 0.1);
 }
+
+namespace {
+// Sightings of an odometry-frame point from a robot driving past it (y 1.5 m below it, from
+// 4 m before to 1 m before), laser ranges `bias` too long (the furniture behind).
+std::vector<Sighting> raysTo(const Eigen::Vector2d& x, double bias) {
+  std::vector<Sighting> rays;
+  for (double dx = -4.0; dx <= -1.0; dx += 0.5) {
+    const Eigen::Vector2d o = x + Eigen::Vector2d(dx, -1.5);
+    const Eigen::Vector2d d = x - o;
+    rays.push_back({o, std::atan2(d.y(), d.x()), d.norm() + bias});
+  }
+  return rays;
+}
+}  // namespace
+
+TEST(SectionTracker, FitSimilarityRaysTrustsBearingsOverRangesThatHitTheFurnitureBehind) {
+  const Fixes f = seenThrough(1.06, 0.08, {0.2, -0.1});
+  std::vector<RayFix> rf;
+  std::vector<Eigen::Vector2d> ranged_pts;  // what a point fit gets: the biased ranges' points
+  for (size_t i = 0; i < f.route.size(); ++i) {
+    RayFix x;
+    x.route_pt = f.route[i];
+    if (i == 0) {
+      x.is_point = true;
+      x.odom_pt = f.odom[0];
+      ranged_pts.push_back(f.odom[0]);
+    } else {
+      x.rays = raysTo(f.odom[i], 0.6);
+      const auto& last = x.rays.back();
+      ranged_pts.push_back(last.origin + last.range_m * Eigen::Vector2d(std::cos(last.direction),
+                                                                        std::sin(last.direction)));
+    }
+    rf.push_back(x);
+  }
+  SectionTracker rays(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const auto fit = rays.fitSimilarityRays(rf, RayFitParams{});
+  ASSERT_TRUE(fit.ok);
+  EXPECT_EQ(fit.dropped, 0);
+  const Eigen::Vector2d goal(14, -4), truth = f.odom.back();
+  EXPECT_LT((rays.toOdom(goal) - truth).norm(), 0.12);
+  EXPECT_NEAR(rays.scale(), 1.06, 0.02);
+  SectionTracker points(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  points.fitSimilarity(f.route, ranged_pts, 0.15);
+  EXPECT_GT((points.toOdom(goal) - truth).norm(), 0.25);
+}
+
+TEST(SectionTracker, FitSimilarityRaysLeavesOutALandmarkSeenElsewhere) {
+  const Fixes f = seenThrough(1.0, -0.05, {0, 0});
+  std::vector<RayFix> rf;
+  for (size_t i = 0; i < f.route.size(); ++i) {
+    RayFix x;
+    x.route_pt = f.route[i];
+    x.is_point = i == 0;
+    x.odom_pt = f.odom[i];
+    // Landmark 3: a same-class one 1.2 m away was taken for it.
+    if (i > 0)
+      x.rays =
+          raysTo(f.odom[i] + (i == 3 ? Eigen::Vector2d(1.2, 0.4) : Eigen::Vector2d::Zero()), 0.0);
+    rf.push_back(x);
+  }
+  SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const auto fit = t.fitSimilarityRays(rf, RayFitParams{});
+  ASSERT_TRUE(fit.ok);
+  EXPECT_EQ(fit.dropped, 1);
+  EXPECT_FALSE(fit.used[3]);
+  EXPECT_LT((t.toOdom({14, -4}) - f.odom.back()).norm(), 0.05);
+}
+
+TEST(SectionTracker, FitSimilarityRaysNeedsTwoUsableFixes) {
+  SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  RayFix start;
+  start.is_point = true;
+  RayFix empty;  // a landmark without sightings counts for nothing
+  empty.route_pt = {5, 0};
+  EXPECT_FALSE(t.fitSimilarityRays({start, empty}, RayFitParams{}).ok);
+  EXPECT_NEAR(t.scale(), 1.0, 1e-12);
+}

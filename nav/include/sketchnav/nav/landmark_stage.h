@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "sketchnav/nav/perception.h"
+#include "sketchnav/nav/sections.h"  // Sighting
 
 namespace sketchnav::nav {
 
@@ -39,14 +40,6 @@ struct Candidate {
 /// or -1 when none passes the gates. Ties (equal cost) go to more inliers.
 int selectCandidate(const std::vector<Candidate>& candidates, const std::string& class_name,
                     double predicted_bearing, double predicted_range, const SelectParams& p);
-
-/// One sighting of a landmark: the ray from the camera (odometry frame) along its bearing, and
-/// the laser / sonar range along it (<= 0 = none).
-struct Sighting {
-  Eigen::Vector2d origin{0, 0};  // [m] robot position
-  double direction = 0;          // [rad] odometry-frame bearing of the landmark
-  double range_m = 0;            // [m]
-};
 
 // Where a landmark is, from all its sightings. The laser range along a landmark's bearing is
 // the range to whatever the low laser plane hits there: a carton standing 0.2 m in front of a

@@ -36,6 +36,37 @@ struct SectionParams {
   void validate() const;  // InputError "nav.sections.<field> = ...: ..."
 };
 
+/// One sighting of a landmark: the ray from the camera (odometry frame) along its bearing, and
+/// the laser / sonar range along it (<= 0 = none).
+struct Sighting {
+  Eigen::Vector2d origin{0, 0};  // [m] robot position
+  double direction = 0;          // [rad] odometry-frame bearing of the landmark
+  double range_m = 0;            // [m]
+};
+
+/// One fix for SectionTracker::fitSimilarityRays(): where the sketch puts a point (route frame)
+/// and how it was observed — either a known odometry-frame position (the start) or the
+/// sightings of a landmark.
+struct RayFix {
+  Eigen::Vector2d route_pt{0, 0};
+  bool is_point = false;          // odom_pt known (with sigma_m), else `rays`
+  Eigen::Vector2d odom_pt{0, 0};  // [m]
+  double sigma_m = 0.05;          // [m] of odom_pt
+  std::vector<Sighting> rays;
+};
+
+struct RayFitParams {
+  double sketch_sigma_m = 0.3;     // [m] how far off the user draws a landmark (per axis)
+  double bearing_sigma_deg = 1.0;  // [deg] of a detection's bearing
+  double range_sigma_m = 0.35;     // [m] of a laser range along a landmark's bearing: loose,
+                                   // it is often the furniture behind the landmark
+  double range_gate_m = 0.25;      // [m] ranges further than this (+ 2 sigma) from where the
+                                   // bearings cross are left out
+  double outlier_m = 0.6;          // [m] a landmark fix further than this off the fit (in
+                                   // sketch-sigma metres, see fitSimilarityRays) is left out
+  double max_scale_change = 0.15;  // relative, per fit
+};
+
 struct SectionProgress {
   double along_m = 0;      // distance travelled along the current section (projection)
   double cross_m = 0;      // signed lateral offset from it (left positive)
@@ -88,6 +119,15 @@ class SectionTracker {
   Fit fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
                     const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15,
                     double outlier_m = 0);
+  /// The same refit from the rays of each landmark's sightings instead of one point per
+  /// landmark. A bearing is good to a degree, a laser range along it often is not (the laser
+  /// plane passes under a carton and hits the furniture behind: 0.2-0.4 m too far, in the same
+  /// direction for every landmark on a bench face), so bearings carry the fit and ranges only
+  /// hold it where bearings cannot. Each landmark weighs as one fix (its rays share its sketch
+  /// error); a landmark fix whose Mahalanobis residual (times sketch_sigma_m) exceeds
+  /// `outlier_m` is left out, down to three fixes.
+  /// Linear least squares in (s cos a, s sin a, t).
+  Fit fitSimilarityRays(const std::vector<RayFix>& fixes, const RayFitParams& p);
   double scale() const { return scale_; }
 
   SectionProgress progress(const hw::Pose2D& odom) const;
