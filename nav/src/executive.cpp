@@ -178,7 +178,7 @@ struct Executive::Impl {
   double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
-  std::vector<std::vector<Sighting>> fixes_rays;         // their sightings (none: the start)
+  std::vector<Eigen::Matrix2d> fixes_info;               // how well each was seen [1/m^2]
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -693,13 +693,13 @@ struct Executive::Impl {
     }
   }
 
-  // Range at which a servoed landmark counts as passed: its lateral distance from the path,
-  // or, for a landmark ahead beyond the section's end (on the wall the route turns at), its
-  // sketched distance from that end, so that re-anchoring on it puts the end where the robot is.
   // Sightings further than this are not ranged fixes (the laser along the bearing may hit
   // something else that far out).
   double fixRange() const { return s.exec.max_approach_m + 1.5; }
 
+  // Range at which a servoed landmark counts as passed: its lateral distance from the path,
+  // or, for a landmark ahead beyond the section's end (on the wall the route turns at), its
+  // sketched distance from that end, so that re-anchoring on it puts the end where the robot is.
   double passDistance(int k, const mapsketch::ExpectedLandmark& lm) const {
     const auto& sec = tracker.route().sections[k];
     double d = lm.range_m;
@@ -747,7 +747,7 @@ struct Executive::Impl {
       const Eigen::Vector2d shift = seen - tracker.toOdom(lm.position_m);
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
-      fixes_rays.push_back(tr.sightings);
+      fixes_info.push_back(lf.information);
       // With enough fixes spread far enough: refit rotation, scale and translation to the
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
       // part of the way to this one (hand-drawn maps are also locally distorted).
@@ -759,21 +759,14 @@ struct Executive::Impl {
         for (const auto& b : fr) span = std::max(span, (a - b).norm());
       if (n >= 3 && span >= s.exec.fit_min_span_m) {
         SectionTracker::Fit f;
-        if (s.exec.fit_rays) {
-          RayFitParams rp;
-          rp.bearing_sigma_deg = s.locate.bearing_sigma_deg;
-          rp.outlier_m = s.exec.fit_outlier_m;
-          rp.max_scale_change = s.exec.fit_max_scale_change;
-          std::vector<RayFix> rf;
-          for (size_t j = fixes_route.size() - n; j < fixes_route.size(); ++j) {
-            RayFix x;
-            x.route_pt = fixes_route[j];
-            x.is_point = fixes_rays[j].empty();
-            x.odom_pt = fixes_odom[j];
-            x.rays = fixes_rays[j];
-            rf.push_back(std::move(x));
-          }
-          f = tracker.fitSimilarityRays(rf, rp);
+        if (s.exec.fit_weighted) {
+          WeightedFitParams wp;
+          wp.outlier_m = s.exec.fit_outlier_m;
+          wp.max_scale_change = s.exec.fit_max_scale_change;
+          std::vector<WeightedFix> wf;
+          for (size_t j = fixes_route.size() - n; j < fixes_route.size(); ++j)
+            wf.push_back({fixes_route[j], fixes_odom[j], fixes_info[j], j == 0});
+          f = tracker.fitSimilarityWeighted(wf, wp);
         } else {
           f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
         }
@@ -845,7 +838,7 @@ void Executive::start() {
   I.fix_odom = I.tracker.toOdom(I.fix_route);
   I.fixes_route = {I.fix_route};
   I.fixes_odom = {I.fix_odom};
-  I.fixes_rays = {{}};
+  I.fixes_info = {Eigen::Matrix2d::Identity() / (0.05 * 0.05)};  // the start: where it is put
   I.safety.start(I.t0);
   I.status = RunStatus::Running;
   I.event({{"type", "start"},

@@ -55,97 +55,82 @@ void LocateParams::validate() const {
   require(range_gate_m > 0, "nav.locate.range_gate_m", "must be > 0");
 }
 
-namespace {
-// Weighted least squares of a point from line constraints n.p = c (unit n, weight w).
-struct Lines {
-  Eigen::Matrix2d A = Eigen::Matrix2d::Zero();
-  Eigen::Vector2d b = Eigen::Vector2d::Zero();
-  void add(const Eigen::Vector2d& n, double c, double w) {
-    A += w * n * n.transpose();
-    b += w * c * n;
-  }
-};
-Eigen::Vector2d unit(double a) {
-  return {std::cos(a), std::sin(a)};
-}
-Eigen::Vector2d normal(double a) {
-  return {-std::sin(a), std::cos(a)};
-}
-}  // namespace
-
 LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& p) {
   LandmarkFix f;
   if (ss.empty()) return f;
   const double sb = p.bearing_sigma_deg * M_PI / 180;
-  // Ranges alone: the median of the ranged points (robust to one stray return).
-  std::vector<Eigen::Vector2d> ranged;
-  for (const auto& s : ss)
-    if (s.range_m > 0) ranged.push_back(s.origin + s.range_m * unit(s.direction));
-  auto rangesOnly = [&] {
-    LandmarkFix r;
-    if (ranged.empty()) return r;
-    std::vector<double> xs, ys;
-    for (const auto& q : ranged) xs.push_back(q.x()), ys.push_back(q.y());
-    std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
-    std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
-    r.ok = true;
-    r.position = {xs[xs.size() / 2], ys[ys.size() / 2]};
-    r.rays = static_cast<int>(ss.size());
-    r.ranges_used = static_cast<int>(ranged.size());
-    return r;
-  };
-
-  // Spread of the rays' directions.
-  double lo = 1e9, hi = -1e9;
+  auto unit = [](double a) { return Eigen::Vector2d(std::cos(a), std::sin(a)); };
+  // Bearings: each pins the point across its ray to (distance x bearing error), the distance
+  // from a first pass. A tiny prior at the rays' nominal points keeps the system solvable
+  // when they are all parallel.
+  Eigen::Matrix2d I;
+  Eigen::Vector2d b, nominal(0, 0), mean_dir(0, 0);
+  for (const auto& s : ss) {
+    const Eigen::Vector2d u = unit(s.direction);
+    nominal += s.origin + (s.range_m > 0 ? s.range_m : 3.0) * u;
+    mean_dir += u;
+  }
+  nominal /= ss.size();
+  Eigen::Vector2d x = nominal;
+  for (int pass = 0; pass < 2; ++pass) {
+    I = 1e-6 * Eigen::Matrix2d::Identity();
+    b = 1e-6 * nominal;
+    for (const auto& s : ss) {
+      const Eigen::Vector2d u = unit(s.direction), nn(-u.y(), u.x());
+      const double d =
+          std::max(0.5, pass == 0 && s.range_m > 0 ? s.range_m : (x - s.origin).norm());
+      const double w = 1.0 / (d * d * sb * sb);
+      I += w * nn * nn.transpose(), b += w * nn.dot(s.origin) * nn;
+    }
+    x = I.ldlt().solve(b);
+  }
+  const Eigen::Vector2d crossing = x;
+  const Eigen::Matrix2d Cb = I.inverse();
+  mean_dir.normalize();
+  double lo = 0, hi = 0;  // spread of the rays' directions
   for (const auto& s : ss) {
     const double d = wrapAngle(s.direction - ss.front().direction);
     lo = std::min(lo, d), hi = std::max(hi, d);
   }
-  if ((hi - lo) < p.min_spread_deg * M_PI / 180) return rangesOnly();
-
-  // Bearings only, each weighted by its distance (a bearing error moves the point across the
-  // ray by range x error): first with the ranges' (or a nominal) distance, then with the
-  // distance to the first solution.
-  Eigen::Vector2d x = ranged.empty() ? ss.front().origin : rangesOnly().position;
-  Lines L;
-  for (int it = 0; it < 2; ++it) {
-    L = Lines{};
-    for (const auto& s : ss) {
-      const double r = std::max(0.5, (x - s.origin).norm());
-      const Eigen::Vector2d n = normal(s.direction);
-      L.add(n, n.dot(s.origin), 1.0 / (r * r * sb * sb));
-    }
-    if (std::abs(L.A.determinant()) < 1e-12) return rangesOnly();
-    x = L.A.ldlt().solve(L.b);
+  f.triangulated = hi - lo >= p.min_spread_deg * M_PI / 180 &&
+                   std::sqrt(std::max(0.0, mean_dir.dot(Cb * mean_dir))) <= p.max_along_sigma_m;
+  // What a range is judged against: the crossing, or (no crossing) the median ranged point.
+  Eigen::Vector2d ref = crossing;
+  if (!f.triangulated) {
+    std::vector<double> xs, ys;
+    for (const auto& s : ss)
+      if (s.range_m > 0) {
+        const Eigen::Vector2d q = s.origin + s.range_m * unit(s.direction);
+        xs.push_back(q.x()), ys.push_back(q.y());
+      }
+    if (xs.empty()) return f;  // neither crossing bearings nor a range
+    std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
+    std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
+    ref = {xs[xs.size() / 2], ys[ys.size() / 2]};
   }
-  // Behind the rays (they diverge): no crossing.
-  for (const auto& s : ss)
-    if (unit(s.direction).dot(x - s.origin) <= 0) return rangesOnly();
-  const Eigen::Matrix2d cov = L.A.inverse();
-  // Uncertainty along the mean view direction: what the bearings fail to pin down.
-  Eigen::Vector2d mean_dir(0, 0);
-  for (const auto& s : ss) mean_dir += unit(s.direction);
-  mean_dir.normalize();
-  const double along_sigma = std::sqrt(std::max(0.0, mean_dir.dot(cov * mean_dir)));
-  if (along_sigma > p.max_along_sigma_m) return rangesOnly();
-
-  // Ranges that agree with the crossing point refine it; the others hit something else.
-  f.ok = true;
-  f.triangulated = true;
-  f.rays = static_cast<int>(ss.size());
-  Lines all = L;
+  std::vector<const Sighting*> agree;
   for (const auto& s : ss) {
     if (s.range_m <= 0) continue;
     const Eigen::Vector2d u = unit(s.direction);
-    const double predicted = u.dot(x - s.origin);
-    if (std::abs(s.range_m - predicted) > p.range_gate_m + 2 * along_sigma) {
+    const double slack = f.triangulated ? 2 * std::sqrt(std::max(0.0, u.dot(Cb * u))) : 0.0;
+    if (std::abs(u.dot(ref - s.origin) - s.range_m) > p.range_gate_m + slack)
       ++f.ranges_dropped;
-      continue;
-    }
-    all.add(u, u.dot(s.origin) + s.range_m, 1.0 / (p.range_sigma_m * p.range_sigma_m));
-    ++f.ranges_used;
+    else
+      agree.push_back(&s);
   }
-  f.position = all.A.ldlt().solve(all.b);
+  // The ranges' error is mostly one bias shared by all of them (the same furniture behind),
+  // so together they are worth range_sigma_m, not range_sigma_m / sqrt(n).
+  f.ranges_used = static_cast<int>(agree.size());
+  for (const Sighting* s : agree) {
+    const Eigen::Vector2d u = unit(s->direction);
+    const double wr = 1.0 / (agree.size() * p.range_sigma_m * p.range_sigma_m);
+    I += wr * u * u.transpose(), b += wr * (u.dot(s->origin) + s->range_m) * u;
+  }
+  if (!f.triangulated && f.ranges_used == 0) return f;
+  f.ok = true;
+  f.rays = static_cast<int>(ss.size());
+  f.position = I.ldlt().solve(b);
+  f.information = I;
   return f;
 }
 

@@ -132,111 +132,69 @@ SectionTracker::Fit SectionTracker::fitSimilarity(const std::vector<Eigen::Vecto
   return f;
 }
 
-SectionTracker::Fit SectionTracker::fitSimilarityRays(const std::vector<RayFix>& fixes,
-                                                      const RayFitParams& p) {
+SectionTracker::Fit SectionTracker::fitSimilarityWeighted(const std::vector<WeightedFix>& fixes,
+                                                          const WeightedFitParams& p) {
   Fit f;
   const size_t n = fixes.size();
   std::vector<bool> use(n, true);
-  const double sb = p.bearing_sigma_deg * M_PI / 180;
-  const double ss = p.sketch_sigma_m * p.sketch_sigma_m;
-  // Each fix as a point with an information matrix: a landmark is where its rays cross (each
-  // bearing pins it across its ray to range x bearing error; each range along it, loosely),
-  // and the sketch's own error (sketch_sigma_m, the same for all its rays) is added to that
-  // covariance once. Rays that barely spread leave the point free along them, so a biased
-  // range moves the fit little, and the across-ray information still counts in full.
-  struct Point {
-    Eigen::Vector2d x;
-    Eigen::Matrix2d W;
-  };
-  std::vector<Point> pts(n);
+  // Each fix's weight: the inverse of its observation covariance plus the sketch's error (a
+  // trusted fix, the start, has no sketch error of its own).
+  std::vector<Eigen::Matrix2d> W(n);
+  const Eigen::Matrix2d S = p.sketch_sigma_m * p.sketch_sigma_m * Eigen::Matrix2d::Identity();
   for (size_t i = 0; i < n; ++i) {
-    const RayFix& fx = fixes[i];
-    if (fx.is_point) {
-      pts[i] = {fx.odom_pt, Eigen::Matrix2d::Identity() / (fx.sigma_m * fx.sigma_m)};
-      continue;
-    }
-    if (fx.rays.empty()) {
+    const Eigen::Matrix2d& I = fixes[i].information;
+    if (std::abs(I.determinant()) < 1e-12) {
       use[i] = false;
       continue;
     }
-    // Bearings first; a range joins only when it agrees with where they cross (a range far
-    // behind that is the furniture), or when they do not cross well enough to judge it.
-    Eigen::Matrix2d I = 1e-6 * Eigen::Matrix2d::Identity();  // a nominal prior: never singular
-    Eigen::Vector2d bb = Eigen::Vector2d::Zero(), mean(0, 0);
-    for (const auto& s : fx.rays) {
-      const Eigen::Vector2d u(std::cos(s.direction), std::sin(s.direction)), nn(-u.y(), u.x());
-      const double d = s.range_m > 0 ? s.range_m : 3.0;
-      const double wb = 1.0 / (d * d * sb * sb);
-      I += wb * nn * nn.transpose(), bb += wb * nn.dot(s.origin) * nn;
-      mean += s.origin + d * u;
-    }
-    bb += 1e-6 * mean / fx.rays.size();  // the prior centred on the rays' nominal points
-    const Eigen::Vector2d xb = I.ldlt().solve(bb);
-    const Eigen::Matrix2d Cb = I.inverse();
-    const double wr = 1.0 / (p.range_sigma_m * p.range_sigma_m);
-    for (const auto& s : fx.rays) {
-      if (s.range_m <= 0) continue;
-      const Eigen::Vector2d u(std::cos(s.direction), std::sin(s.direction));
-      const double along = std::sqrt(std::max(0.0, u.dot(Cb * u)));
-      if (std::abs(u.dot(xb - s.origin) - s.range_m) > p.range_gate_m + 2 * along) continue;
-      I += wr * u * u.transpose(), bb += wr * (u.dot(s.origin) + s.range_m) * u;
-    }
-    const Eigen::Matrix2d C = I.inverse() + ss * Eigen::Matrix2d::Identity();
-    pts[i] = {I.ldlt().solve(bb), C.inverse()};
+    W[i] = fixes[i].trusted ? I : Eigen::Matrix2d((I.inverse() + S).inverse());
   }
   // d(M r + t)/dq for q = (s cos a, s sin a, tx, ty), r relative to the route's start.
-  auto jac = [&](const Eigen::Vector2d& route_pt) {
-    const Eigen::Vector2d r = route_pt - route_.start_m;
+  auto jac = [&](size_t i) {
+    const Eigen::Vector2d r = fixes[i].route_pt - route_.start_m;
     Eigen::Matrix<double, 2, 4> J;
     J << r.x(), -r.y(), 1, 0, r.y(), r.x(), 0, 1;
     return J;
   };
-  // How far a fix is from the fit, in metres of sketch error: the Mahalanobis distance under
-  // its covariance (so a displacement along poorly crossing rays counts for little) times
-  // sketch_sigma_m. The start (a point fix) is trusted and never left out.
   auto residual = [&](size_t i, const Eigen::Vector4d& q) {
-    const Eigen::Vector2d d = jac(fixes[i].route_pt) * q - pts[i].x;
-    return std::sqrt(std::max(0.0, d.dot(pts[i].W * d))) * p.sketch_sigma_m;
+    const Eigen::Vector2d d = jac(i) * q - fixes[i].odom_pt;
+    return std::sqrt(std::max(0.0, d.dot(W[i] * d))) * p.sketch_sigma_m;
   };
   Eigen::Vector4d q;
   for (;;) {
     size_t m = 0;
     Eigen::Matrix4d A = Eigen::Matrix4d::Zero();
     Eigen::Vector4d b = Eigen::Vector4d::Zero();
-    for (size_t i = 0; i < n; ++i) {
-      if (!use[i]) continue;
-      ++m;
-      const auto J = jac(fixes[i].route_pt);
-      A += J.transpose() * pts[i].W * J;
-      b += J.transpose() * pts[i].W * pts[i].x;
-    }
+    for (size_t i = 0; i < n; ++i)
+      if (use[i]) {
+        const auto J = jac(i);
+        A += J.transpose() * W[i] * J;
+        b += J.transpose() * W[i] * fixes[i].odom_pt;
+        ++m;
+      }
     if (m < 2) return f;
     Eigen::FullPivLU<Eigen::Matrix4d> lu(A);
     if (lu.rank() < 4) return f;
     q = lu.solve(b);
     // The scale moves at most max_scale_change; clamped, the translation is refitted.
     const double sc = std::hypot(q[0], q[1]);
-    const double lo = scale_ * (1 - p.max_scale_change), hi = scale_ * (1 + p.max_scale_change);
     if (sc < 1e-9) return f;
+    const double lo = scale_ * (1 - p.max_scale_change), hi = scale_ * (1 + p.max_scale_change);
     if (sc < lo || sc > hi) {
       const double k = std::clamp(sc, lo, hi) / sc;
       q[0] *= k, q[1] *= k;
+      q[2] = q[3] = 0;
       Eigen::Matrix2d At = Eigen::Matrix2d::Zero();
       Eigen::Vector2d bt = Eigen::Vector2d::Zero();
       for (size_t i = 0; i < n; ++i)
-        if (use[i]) {
-          Eigen::Vector4d q0 = q;
-          q0[2] = q0[3] = 0;
-          At += pts[i].W;
-          bt += pts[i].W * (pts[i].x - jac(fixes[i].route_pt) * q0);
-        }
+        if (use[i]) At += W[i], bt += W[i] * (fixes[i].odom_pt - jac(i) * q);
       q.tail<2>() = At.ldlt().solve(bt);
     }
     if (p.outlier_m <= 0 || m <= 3) break;
     size_t worst = n;
     double worst_r = p.outlier_m;
     for (size_t i = 0; i < n; ++i)
-      if (use[i] && !fixes[i].is_point) {
+      if (use[i] && !fixes[i].trusted) {
         const double r = residual(i, q);
         if (r > worst_r) worst_r = r, worst = i;
       }
@@ -252,8 +210,8 @@ SectionTracker::Fit SectionTracker::fitSimilarityRays(const std::vector<RayFix>&
   trans_ = q.tail<2>();
   size_t m = 0;
   for (size_t i = 0; i < n; ++i)
-    if (use[i]) f.rms += (jac(fixes[i].route_pt) * q - pts[i].x).squaredNorm(), ++m;
-  f.rms = m ? std::sqrt(f.rms / m) : 0;
+    if (use[i]) f.rms += (jac(i) * q - fixes[i].odom_pt).squaredNorm(), ++m;
+  f.rms = std::sqrt(f.rms / m);
   f.used = use;
   f.ok = true;
   return f;

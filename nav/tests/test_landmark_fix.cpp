@@ -46,14 +46,21 @@ TEST(LocateLandmark, BearingsOutvoteRangesThatHitTheFurnitureBehind) {
   EXPECT_GT(mean_err / ss.size(), 0.5);
 }
 
-TEST(LocateLandmark, RangesThatHitTheLandmarkRefineTheCrossing) {
+TEST(LocateLandmark, RangesThatAgreeWithTheCrossingAddInformationAlongTheView) {
   const Eigen::Vector2d lm(5.0, -0.9);
   const auto ss = driveBy(lm, 0.5, 3.5, 12, 1.0, 0.0);
   const LandmarkFix f = locateLandmark(ss, LocateParams{});
   ASSERT_TRUE(f.ok);
   EXPECT_TRUE(f.triangulated);
   EXPECT_EQ(f.ranges_used, 12);
-  EXPECT_LT((f.position - lm).norm(), 0.05);
+  EXPECT_LT((f.position - lm).norm(), 0.2);
+  auto bearings_only = ss;
+  for (auto& s : bearings_only) s.range_m = 0;
+  const LandmarkFix fb = locateLandmark(bearings_only, LocateParams{});
+  ASSERT_TRUE(fb.ok);
+  const Eigen::Vector2d view = (lm - Eigen::Vector2d(2.0, 0.0)).normalized();
+  // Together the ranges count as one range of range_sigma_m (1 / 0.35^2 = 8 per m^2).
+  EXPECT_GT(view.dot(f.information * view), view.dot(fb.information * view) + 6.0);
 }
 
 TEST(LocateLandmark, TooLittleSpreadLeavesItToTheRanges) {

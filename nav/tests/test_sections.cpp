@@ -180,8 +180,9 @@ TEST(SectionTracker, FitSimilarityLeavesOutAFixFarOffTheOthers) {
 
 namespace {
 // Sightings of an odometry-frame point from a robot driving past it (y 1.5 m below it, from
-// 4 m before to 1 m before), laser ranges `bias` too long (the furniture behind).
-std::vector<Sighting> raysTo(const Eigen::Vector2d& x, double bias) {
+// 4 m before to 1 m before: the bearings cross), laser ranges `bias` too long (the furniture
+// behind).
+std::vector<Sighting> raysPast(const Eigen::Vector2d& x, double bias) {
   std::vector<Sighting> rays;
   for (double dx = -4.0; dx <= -1.0; dx += 0.5) {
     const Eigen::Vector2d o = x + Eigen::Vector2d(dx, -1.5);
@@ -190,67 +191,102 @@ std::vector<Sighting> raysTo(const Eigen::Vector2d& x, double bias) {
   }
   return rays;
 }
-}  // namespace
-
-TEST(SectionTracker, FitSimilarityRaysTrustsBearingsOverRangesThatHitTheFurnitureBehind) {
-  const Fixes f = seenThrough(1.06, 0.08, {0.2, -0.1});
-  std::vector<RayFix> rf;
-  std::vector<Eigen::Vector2d> ranged_pts;  // what a point fit gets: the biased ranges' points
+// ...and from a robot heading straight at it along `heading` (4 to 2 m away: the bearings do
+// not cross at all).
+std::vector<Sighting> raysTowards(const Eigen::Vector2d& x, double heading, double bias) {
+  std::vector<Sighting> rays;
+  for (double d = 4.0; d >= 2.0; d -= 0.5)
+    rays.push_back(
+        {x - d * Eigen::Vector2d(std::cos(heading), std::sin(heading)), heading, d + bias});
+  return rays;
+}
+// The fixes of `f` (start first, trusted) located from `rays(i)`; `points` gets the located
+// points for an equal-weight fit.
+template <class Rays>
+std::vector<WeightedFix> locatedFixes(const Fixes& f, Rays rays,
+                                      std::vector<Eigen::Vector2d>* points) {
+  std::vector<WeightedFix> wf;
   for (size_t i = 0; i < f.route.size(); ++i) {
-    RayFix x;
+    WeightedFix x;
     x.route_pt = f.route[i];
     if (i == 0) {
-      x.is_point = true;
       x.odom_pt = f.odom[0];
-      ranged_pts.push_back(f.odom[0]);
+      x.information = Eigen::Matrix2d::Identity() / (0.05 * 0.05);
+      x.trusted = true;
     } else {
-      x.rays = raysTo(f.odom[i], 0.6);
-      const auto& last = x.rays.back();
-      ranged_pts.push_back(last.origin + last.range_m * Eigen::Vector2d(std::cos(last.direction),
-                                                                        std::sin(last.direction)));
+      const LandmarkFix lf = locateLandmark(rays(i), LocateParams{});
+      EXPECT_TRUE(lf.ok);
+      x.odom_pt = lf.position;
+      x.information = lf.information;
     }
-    rf.push_back(x);
+    points->push_back(x.odom_pt);
+    wf.push_back(x);
   }
-  SectionTracker rays(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
-  const auto fit = rays.fitSimilarityRays(rf, RayFitParams{});
+  return wf;
+}
+}  // namespace
+
+TEST(SectionTracker, FitSimilarityWeightedIgnoresRangesThatHitTheFurnitureBehind) {
+  // Bearings that cross: the located points are good, both fits are.
+  const Fixes f = seenThrough(1.06, 0.08, {0.2, -0.1});
+  std::vector<Eigen::Vector2d> pts;
+  const auto wf = locatedFixes(
+      f, [&](size_t i) { return raysPast(f.odom[i], 0.6); }, &pts);
+  SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const auto fit = t.fitSimilarityWeighted(wf, WeightedFitParams{});
   ASSERT_TRUE(fit.ok);
   EXPECT_EQ(fit.dropped, 0);
   const Eigen::Vector2d goal(14, -4), truth = f.odom.back();
-  EXPECT_LT((rays.toOdom(goal) - truth).norm(), 0.12);
-  EXPECT_NEAR(rays.scale(), 1.06, 0.02);
-  SectionTracker points(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
-  points.fitSimilarity(f.route, ranged_pts, 0.15);
-  EXPECT_GT((points.toOdom(goal) - truth).norm(), 0.25);
+  EXPECT_LT((t.toOdom(goal) - truth).norm(), 0.1);
+  EXPECT_NEAR(t.scale(), 1.06, 0.02);
 }
 
-TEST(SectionTracker, FitSimilarityRaysLeavesOutALandmarkSeenElsewhere) {
+TEST(SectionTracker, FitSimilarityWeightedTrustsBearingsWhereOnlyRangesPlaceALandmarkAlong) {
+  // Headed straight at each landmark, from a different direction each time: only the (0.4 m
+  // too long) ranges place a landmark along its rays. Weighted, the fit leans on each across
+  // its rays (0.3 m of sketch error) more than along them (0.3 m and 0.35 m of range bias), so
+  // the biases, in different directions, move it less than with equal weights.
+  const Fixes f = seenThrough(1.0, 0.0, {0, 0});
+  const double headings[] = {0, 1.2, -0.4, 0.9, -1.1, 0.3};
+  std::vector<Eigen::Vector2d> pts;
+  const auto wf = locatedFixes(
+      f, [&](size_t i) { return raysTowards(f.odom[i], headings[i], 0.4); }, &pts);
+  SectionTracker weighted(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  ASSERT_TRUE(weighted.fitSimilarityWeighted(wf, WeightedFitParams{}).ok);
+  SectionTracker equal(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  ASSERT_TRUE(equal.fitSimilarity(f.route, pts, 0.15).ok);
+  const Eigen::Vector2d goal(14, -4), truth = f.odom.back();
+  const double ew = (weighted.toOdom(goal) - truth).norm();
+  const double ee = (equal.toOdom(goal) - truth).norm();
+  EXPECT_LT(ew, 0.85 * ee) << "weighted " << ew << " m, equal weights " << ee << " m";
+}
+
+TEST(SectionTracker, FitSimilarityWeightedLeavesOutALandmarkSeenElsewhere) {
   const Fixes f = seenThrough(1.0, -0.05, {0, 0});
-  std::vector<RayFix> rf;
-  for (size_t i = 0; i < f.route.size(); ++i) {
-    RayFix x;
-    x.route_pt = f.route[i];
-    x.is_point = i == 0;
-    x.odom_pt = f.odom[i];
-    // Landmark 3: a same-class one 1.2 m away was taken for it.
-    if (i > 0)
-      x.rays =
-          raysTo(f.odom[i] + (i == 3 ? Eigen::Vector2d(1.2, 0.4) : Eigen::Vector2d::Zero()), 0.0);
-    rf.push_back(x);
-  }
+  std::vector<Eigen::Vector2d> pts;
+  // Landmark 3: a same-class one 1.2 m away was taken for it.
+  const auto wf = locatedFixes(
+      f,
+      [&](size_t i) {
+        return raysPast(f.odom[i] + (i == 3 ? Eigen::Vector2d(1.2, 0.4) : Eigen::Vector2d(0, 0)),
+                        0.0);
+      },
+      &pts);
   SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
-  const auto fit = t.fitSimilarityRays(rf, RayFitParams{});
+  const auto fit = t.fitSimilarityWeighted(wf, WeightedFitParams{});
   ASSERT_TRUE(fit.ok);
   EXPECT_EQ(fit.dropped, 1);
   EXPECT_FALSE(fit.used[3]);
   EXPECT_LT((t.toOdom({14, -4}) - f.odom.back()).norm(), 0.05);
 }
 
-TEST(SectionTracker, FitSimilarityRaysNeedsTwoUsableFixes) {
+TEST(SectionTracker, FitSimilarityWeightedNeedsTwoUsableFixes) {
   SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
-  RayFix start;
-  start.is_point = true;
-  RayFix empty;  // a landmark without sightings counts for nothing
-  empty.route_pt = {5, 0};
-  EXPECT_FALSE(t.fitSimilarityRays({start, empty}, RayFitParams{}).ok);
+  WeightedFix start;
+  start.trusted = true;
+  WeightedFix unseen;  // no information: counts for nothing
+  unseen.route_pt = {5, 0};
+  unseen.information.setZero();
+  EXPECT_FALSE(t.fitSimilarityWeighted({start, unseen}, WeightedFitParams{}).ok);
   EXPECT_NEAR(t.scale(), 1.0, 1e-12);
 }

@@ -56,10 +56,11 @@ struct ExecutiveParams {
   double fit_min_span_m = 5.0;         // [m]
   double fit_max_scale_change = 0.15;  // relative, per fit
   double fit_local_gain = 0.3;
-  double fit_outlier_m = 0.6;        // [m] a fix this far off the others' fit is left out
-  bool fit_rays = true;              // fit to each landmark's sighting rays (SectionTracker::
-                                     // fitSimilarityRays), not to one located point per landmark
-  double realign_gain = 0.8;         // how much it re-rotates the route about the previous fix
+  double fit_outlier_m = 0.6;  // [m] a fix this far off the others' fit is left out
+  bool fit_weighted = true;    // each fix weighted by how well it was located (across / along
+                               // its rays, SectionTracker::fitSimilarityWeighted); false: equal
+                               // weights (fitSimilarity)
+  double realign_gain = 0.8;   // how much it re-rotates the route about the previous fix
   double realign_baseline_m = 5.0;   // [m] minimum fix-to-landmark distance for that: a
                                      // sighting is good to ~0.3 m, so a shorter baseline
                                      // turns the route by more than it corrects
@@ -107,7 +108,7 @@ struct ExecutiveParams {
     b("fit_max_scale_change", fit_max_scale_change);
     b("fit_local_gain", fit_local_gain);
     b("fit_outlier_m", fit_outlier_m);
-    b("fit_rays", fit_rays);
+    b("fit_weighted", fit_weighted);
     b("realign_gain", realign_gain);
     b("realign_baseline_m", realign_baseline_m);
     b("perception_period_s", perception_period_s);

@@ -44,17 +44,22 @@ int selectCandidate(const std::vector<Candidate>& candidates, const std::string&
 // Where a landmark is, from all its sightings. The laser range along a landmark's bearing is
 // the range to whatever the low laser plane hits there: a carton standing 0.2 m in front of a
 // bench face, seen at 17 degrees, is "seen" 0.65 m too far (the bench face behind it), and
-// such fixes put the route's goal 0.5-1 m off in the lab experiments. The bearings of a dozen
-// sightings taken as the robot drives by cross at the landmark itself, so when they spread
-// enough the landmark is triangulated from them, and laser ranges are used only where they
-// agree with that (or, with too little spread, alone).
+// such fixes put the route's goal 0.5-1 m off in the lab experiments. The bearings of the
+// sightings taken as the robot drives by cross at the landmark itself, so they pin it across
+// each ray (range x bearing error) and, as far as they spread, along it; a range joins only
+// when it agrees with that crossing (or, when the bearings do not cross, with the other
+// ranges), and then loosely. The result is a point with its information matrix: tight across
+// the view, loose along it when the bearings barely spread (the robot mostly heads towards a
+// landmark) — which is how the sketch refit weighs it (SectionTracker::fitSimilarityWeighted).
 struct LocateParams {
   double bearing_sigma_deg = 1.0;   // [deg] bearing noise of a detection
-  double min_spread_deg = 8;        // [deg] rays spread less than this: ranges decide
-  double max_along_sigma_m = 0.25;  // [m] triangulation weaker than this along the view: ranges
-  double range_sigma_m = 0.08;      // [m] a range that hit the landmark
-  double range_gate_m = 0.25;       // [m] ranges further than this from the triangulated point
-                                    // (+ 2 sigma of it) hit something else and are dropped
+  double min_spread_deg = 8;        // [deg] "triangulated" needs rays spread at least this...
+  double max_along_sigma_m = 0.25;  // [m] ...and the crossing this sharp along the view
+  double range_sigma_m = 0.35;      // [m] of a range along a landmark's bearing: loose, it is
+                                    // often the furniture behind the landmark
+  double range_gate_m = 0.25;       // [m] a range further than this (+ 2 sigma of the
+                                    // crossing) from where the bearings cross, or from the
+                                    // median range when they do not cross, is left out
   template <class B>
   void bind(B& b) {
     b("bearing_sigma_deg", bearing_sigma_deg);
@@ -68,14 +73,15 @@ struct LocateParams {
 
 struct LandmarkFix {
   bool ok = false;
-  Eigen::Vector2d position{0, 0};  // [m] odometry frame
-  bool triangulated = false;       // the bearings fixed it (not only ranges)
-  int rays = 0;                    // sightings used
+  Eigen::Vector2d position{0, 0};                         // [m] odometry frame
+  Eigen::Matrix2d information = Eigen::Matrix2d::Zero();  // [1/m^2] inverse covariance
+  bool triangulated = false;  // the bearings cross well (see LocateParams)
+  int rays = 0;               // sightings used
   int ranges_used = 0, ranges_dropped = 0;
 };
 
 /// The landmark's position from its sightings (see LocateParams). Not ok when there is no
-/// range and the bearings do not cross well enough.
+/// sighting, or no range and the bearings do not cross well enough.
 LandmarkFix locateLandmark(const std::vector<Sighting>& sightings, const LocateParams& p);
 
 }  // namespace sketchnav::nav

@@ -44,26 +44,20 @@ struct Sighting {
   double range_m = 0;            // [m]
 };
 
-/// One fix for SectionTracker::fitSimilarityRays(): where the sketch puts a point (route frame)
-/// and how it was observed — either a known odometry-frame position (the start) or the
-/// sightings of a landmark.
-struct RayFix {
+/// One fix for SectionTracker::fitSimilarityWeighted(): where the sketch puts a point (route
+/// frame), where it was observed (odometry frame) and how well (information matrix, e.g. from
+/// locateLandmark(); the start: exactly).
+struct WeightedFix {
   Eigen::Vector2d route_pt{0, 0};
-  bool is_point = false;          // odom_pt known (with sigma_m), else `rays`
-  Eigen::Vector2d odom_pt{0, 0};  // [m]
-  double sigma_m = 0.05;          // [m] of odom_pt
-  std::vector<Sighting> rays;
+  Eigen::Vector2d odom_pt{0, 0};
+  Eigen::Matrix2d information = Eigen::Matrix2d::Identity();  // [1/m^2]
+  bool trusted = false;  // never left out as an outlier (the start)
 };
 
-struct RayFitParams {
+struct WeightedFitParams {
   double sketch_sigma_m = 0.3;     // [m] how far off the user draws a landmark (per axis)
-  double bearing_sigma_deg = 1.0;  // [deg] of a detection's bearing
-  double range_sigma_m = 0.35;     // [m] of a laser range along a landmark's bearing: loose,
-                                   // it is often the furniture behind the landmark
-  double range_gate_m = 0.25;      // [m] ranges further than this (+ 2 sigma) from where the
-                                   // bearings cross are left out
-  double outlier_m = 0.6;          // [m] a landmark fix further than this off the fit (in
-                                   // sketch-sigma metres, see fitSimilarityRays) is left out
+  double outlier_m = 0.6;          // [m] a fix further than this off the fit (Mahalanobis
+                                   // distance x sketch_sigma_m) is left out
   double max_scale_change = 0.15;  // relative, per fit
 };
 
@@ -119,15 +113,13 @@ class SectionTracker {
   Fit fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
                     const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15,
                     double outlier_m = 0);
-  /// The same refit from the rays of each landmark's sightings instead of one point per
-  /// landmark. A bearing is good to a degree, a laser range along it often is not (the laser
-  /// plane passes under a carton and hits the furniture behind: 0.2-0.4 m too far, in the same
-  /// direction for every landmark on a bench face), so bearings carry the fit and ranges only
-  /// hold it where bearings cannot. Each landmark weighs as one fix (its rays share its sketch
-  /// error); a landmark fix whose Mahalanobis residual (times sketch_sigma_m) exceeds
-  /// `outlier_m` is left out, down to three fixes.
-  /// Linear least squares in (s cos a, s sin a, t).
-  Fit fitSimilarityRays(const std::vector<RayFix>& fixes, const RayFitParams& p);
+  /// The same refit with each fix weighted by how well it was observed plus the sketch's own
+  /// error (sketch_sigma_m, once per landmark): a landmark located only across its rays (the
+  /// robot heading towards it, a laser range that may be the furniture behind) pulls the fit
+  /// across them and hardly along. A fix whose Mahalanobis residual (x sketch_sigma_m) exceeds
+  /// `outlier_m` is left out, down to three fixes. Linear least squares in
+  /// (s cos a, s sin a, t).
+  Fit fitSimilarityWeighted(const std::vector<WeightedFix>& fixes, const WeightedFitParams& p);
   double scale() const { return scale_; }
 
   SectionProgress progress(const hw::Pose2D& odom) const;
