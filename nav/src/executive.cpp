@@ -752,8 +752,11 @@ struct Executive::Impl {
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
       // part of the way to this one (hand-drawn maps are also locally distorted).
       const size_t n = std::min<size_t>(fixes_route.size(), std::max(0, s.exec.fit_fixes));
-      std::vector<Eigen::Vector2d> fr(fixes_route.end() - n, fixes_route.end()),
-          fo(fixes_odom.end() - n, fixes_odom.end());
+      std::vector<size_t> idx;  // the fixes fitted: the last n (and the start, if asked)
+      if (s.exec.fit_keep_start && fixes_route.size() > n) idx.push_back(0);
+      for (size_t j = fixes_route.size() - n; j < fixes_route.size(); ++j) idx.push_back(j);
+      std::vector<Eigen::Vector2d> fr, fo;
+      for (size_t j : idx) fr.push_back(fixes_route[j]), fo.push_back(fixes_odom[j]);
       double span = 0;
       for (const auto& a : fr)
         for (const auto& b : fr) span = std::max(span, (a - b).norm());
@@ -764,8 +767,7 @@ struct Executive::Impl {
           wp.outlier_m = s.exec.fit_outlier_m;
           wp.max_scale_change = s.exec.fit_max_scale_change;
           std::vector<WeightedFix> wf;
-          for (size_t j = fixes_route.size() - n; j < fixes_route.size(); ++j)
-            wf.push_back({fixes_route[j], fixes_odom[j], fixes_info[j], j == 0});
+          for (size_t j : idx) wf.push_back({fixes_route[j], fixes_odom[j], fixes_info[j], j == 0});
           f = tracker.fitSimilarityWeighted(wf, wp);
         } else {
           f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
@@ -776,7 +778,7 @@ struct Executive::Impl {
         e["fit_rotation_deg"] = f.rotation * 180 / M_PI;
         e["fit_scale"] = tracker.scale();
         e["fit_rms_m"] = f.rms;
-        e["fit_fixes"] = n;
+        e["fit_fixes"] = idx.size();
         e["fit_dropped"] = f.dropped;
       } else {
         const double rot = tracker.realign(lm.position_m, seen, fix_route, fix_odom,
