@@ -59,7 +59,7 @@ struct ExecutiveParams {
   // The start stays in every fit: it is where the user put the robot, and it gives the fit a
   // baseline as long as the route. Fitting only the last fit_fixes landmarks (5-7 m apart)
   // let the scale swing 10-15 % per fit and put the goal 0.5-1 m off (the experiments'
-  // "stopped short of the goal": 10 of 52 trials without it, 1 of 33 with it).
+  // "stopped short of the goal": about 10 of 52 trials without it, 3 of 52 with it).
   bool fit_keep_start = true;
   double fit_outlier_m = 0.6;  // [m] a fix this far off the others' fit is left out
   bool fit_weighted = true;    // each fix weighted by how well it was located (across / along
