@@ -78,58 +78,16 @@ double SectionTracker::realign(const Eigen::Vector2d& route_pt, const Eigen::Vec
 SectionTracker::Fit SectionTracker::fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
                                                   const std::vector<Eigen::Vector2d>& odom_pts,
                                                   double max_scale_change, double outlier_m) {
-  Fit f;
-  const size_t n = std::min(route_pts.size(), odom_pts.size());
-  if (n < 2) return f;
-  std::vector<bool> use(n, true);
-  double theta = 0, sc = 1;
-  Eigen::Vector2d mr(0, 0), mo(0, 0);
-  for (;;) {
-    // Least-squares similarity (Umeyama in 2-D, complex form): odom = s R route + t.
-    mr.setZero(), mo.setZero();
-    size_t m = 0;
-    for (size_t i = 0; i < n; ++i)
-      if (use[i]) mr += route_pts[i], mo += odom_pts[i], ++m;
-    mr /= m, mo /= m;
-    double a = 0, b = 0, vr = 0;
-    for (size_t i = 0; i < n; ++i) {
-      if (!use[i]) continue;
-      const Eigen::Vector2d r = route_pts[i] - mr, o = odom_pts[i] - mo;
-      a += r.x() * o.x() + r.y() * o.y();
-      b += r.x() * o.y() - r.y() * o.x();
-      vr += r.squaredNorm();
-    }
-    if (vr < 1e-9) return f;
-    theta = std::atan2(b, a);
-    sc = std::clamp(std::hypot(a, b) / vr, scale_ * (1 - max_scale_change),
-                    scale_ * (1 + max_scale_change));
-    // One fix far off the others' fit (a sighting ranged on the furniture behind the landmark,
-    // a same-class landmark taken for another) is left out rather than averaged in; never
-    // below three fixes.
-    if (outlier_m <= 0 || m <= 3) break;
-    size_t worst = n;
-    double worst_r = outlier_m;
-    for (size_t i = 0; i < n; ++i) {
-      if (!use[i]) continue;
-      const double r = (sc * rot(theta, route_pts[i] - mr) + mo - odom_pts[i]).norm();
-      if (r > worst_r) worst_r = r, worst = i;
-    }
-    if (worst == n) break;
-    use[worst] = false;
-    ++f.dropped;
-  }
-  f.rotation = wrapAngle(theta - rot_);
-  f.scale = sc / scale_;
-  rot_ = theta;
-  scale_ = sc;
-  trans_ = mo - scale_ * rot(rot_, mr - route_.start_m);
-  size_t m = 0;
-  for (size_t i = 0; i < n; ++i)
-    if (use[i]) f.rms += (toOdom(route_pts[i]) - odom_pts[i]).squaredNorm(), ++m;
-  f.rms = std::sqrt(f.rms / m);
-  f.used = use;
-  f.ok = true;
-  return f;
+  // The weighted fit with every fix an exact point: each then weighs 1 / sketch_sigma^2, the
+  // least squares is the plain (Umeyama) similarity, and the Mahalanobis residual times
+  // sketch_sigma is the distance in metres.
+  WeightedFitParams p;
+  p.outlier_m = outlier_m;
+  p.max_scale_change = max_scale_change;
+  std::vector<WeightedFix> fixes;
+  for (size_t i = 0; i < std::min(route_pts.size(), odom_pts.size()); ++i)
+    fixes.push_back({route_pts[i], odom_pts[i], 1e12 * Eigen::Matrix2d::Identity(), false});
+  return fitSimilarityWeighted(fixes, p);
 }
 
 SectionTracker::Fit SectionTracker::fitSimilarityWeighted(const std::vector<WeightedFix>& fixes,
