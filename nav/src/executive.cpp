@@ -476,7 +476,7 @@ struct Executive::Impl {
       LmTrack& t = *x.tr;
       if (t.state != LmState::Tracking || now - t.last_seen <= s.exec.lost_after_s) continue;
       // Out of view when already close (it slid out of the side of the image): passed.
-      if (t.last_range > 0 && t.last_range <= passDistance(x.k, *x.lm) + 1.0) {
+      if (atLandmark(x.k, *x.lm, t.last_range)) {
         passLandmark(x.k, x.i, false);
       } else {
         t.state = LmState::Pending;
@@ -615,8 +615,7 @@ struct Executive::Impl {
         // that furniture, and this is as close as the robot gets. Passing it now keeps the
         // servo from steering back into the furniture after the dodge (a robot circled the
         // lab bench its landmark was on).
-        if (tr && lm && tr->state == LmState::Tracking && tr->last_range > 0 &&
-            tr->last_range <= passDistance(att[0].k, *lm) + 1.0)
+        if (tr && lm && tr->state == LmState::Tracking && atLandmark(att[0].k, *lm, tr->last_range))
           passLandmark(att[0].k, att[0].i, false);
       }
       if (av.ended) event({{"type", "avoid_end"}, {"side", toString(av.side)}});
@@ -706,6 +705,11 @@ struct Executive::Impl {
     if (lm.side == mapsketch::Side::Ahead && lm.along_m >= sec.length_m)
       d = (lm.position_m - sec.end_m).norm();
     return std::clamp(d, s.exec.approach_m, s.exec.max_approach_m);
+  }
+  // A measured range within a metre of the pass distance: the robot is at the landmark (one
+  // that slid out of view there was passed; the furniture being dodged there is its own).
+  bool atLandmark(int k, const mapsketch::ExpectedLandmark& lm, double range) const {
+    return range > 0 && range <= passDistance(k, lm) + 1.0;
   }
 
   void passLandmark(int k, int i, bool seen_close) {
