@@ -39,6 +39,9 @@ void ExecutiveParams::validate() const {
   require(max_missed_in_row >= 0, "nav.max_missed_in_row", "must be >= 0");
   require(goal_stop_s >= 0, "nav.goal_stop_s", "must be >= 0");
   require(dock_m >= 0, "nav.dock_m", "must be >= 0");
+  require(detour_ahead_m > 0.5 && detour_ahead_m <= 10, "nav.detour_ahead_m",
+          "must be in (0.5, 10] m");
+  require(replan_s > 0, "nav.replan_s", "must be > 0");
   require(fit_fixes == 0 || fit_fixes >= 3, "nav.fit_fixes", "must be 0 (off) or >= 3");
   require(fit_min_span_m >= 0, "nav.fit_min_span_m", "must be >= 0");
   require(fit_max_scale_change >= 0 && fit_max_scale_change < 1, "nav.fit_max_scale_change",
@@ -67,6 +70,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.avoid, c, "nav.avoid");
   applyConfig(s.safety, c, "nav.safety");
   applyConfig(s.laser_odometry, c, "nav.laser_odometry");
+  applyConfig(s.planner, c, "nav.planner");
   applyConfig(s.servo, c, "servo");
   return s;
 }
@@ -109,6 +113,7 @@ json ExecutiveSummary::toJson() const {
           {"match_ms_mean", match_ms_mean},
           {"avoidance_manoeuvres", avoidance_manoeuvres},
           {"recoveries", recoveries},
+          {"detours", detours},
           {"laser_odometry",
            {{"scans", laser_odometry.scans},
             {"aligned", laser_odometry.aligned},
@@ -149,6 +154,7 @@ struct Executive::Impl {
   ObstacleAvoider avoider;
   SafetySupervisor safety;
   LaserOdometry lodo;
+  LocalPlanner planner;
 
   RunStatus status = RunStatus::Idle;
   std::string reason;
@@ -175,6 +181,13 @@ struct Executive::Impl {
   double rec_dir = 0, rec_t0 = 0;  // escape heading (odometry frame), start time
   hw::Pose2D rec_from;
   int recoveries = 0;
+  // Planned detour (or docking path) being followed, when it was planned and to where.
+  PlannedPath detour;
+  double detour_t = -1e300;
+  Eigen::Vector2d detour_goal{1e300, 1e300};
+  bool detouring = false;
+  bool moving_seen = false;  // the current manoeuvre has seen something come towards the robot
+  int detours = 0;
   double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
@@ -189,7 +202,8 @@ struct Executive::Impl {
         law(st.servo),
         avoider(st.avoid),
         safety(st.safety),
-        lodo(st.laser_odometry) {
+        lodo(st.laser_odometry),
+        planner(st.planner) {
     s.exec.validate();
     s.select.validate();
     s.locate.validate();
@@ -287,6 +301,7 @@ struct Executive::Impl {
       pose = p;
       have_pose = true;
     }
+    std::vector<size_t> fresh;
     for (size_t i = 0; i < dev.ranges.size(); ++i) {
       hw::RangeScan sc;
       if (dev.ranges[i]->read(sc) && sc.stamp > scan_stamps[i]) {
@@ -294,9 +309,12 @@ struct Executive::Impl {
         safety.rangeScan(sc.stamp);
         if (have_pose) lodo.scan(sc);
         scans[i] = std::move(sc);
+        fresh.push_back(i);
       }
     }
     if (have_pose) pose = lodo.pose();
+    if (have_pose && s.exec.detour)
+      for (size_t i : fresh) planner.insert(pose, scans[i]);
     hw::Frame frame;
     bool have_frame = false;
     if (dev.camera && now + 1e-9 >= frame_stamp + s.exec.camera_period_s - 0.5 * s.exec.tick_s) {
@@ -532,22 +550,39 @@ struct Executive::Impl {
     // Docking: close to the goal with a free straight line to it, drive there directly. The
     // goal is a place, often near a wall or in a doorway, and the avoider would keep dodging
     // the wall behind it; the speed is still capped by the clearance ahead.
+    // Without a free straight line (a goal in a doorway: the line grazes the door frame), a
+    // path planned on the grid leads there, or as near as the robot fits.
     bool docking = false;
     if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.dock_m && !dev.ranges.empty()) {
-      const Polar pg = polarFrom(pose, tracker.toOdom(sec.end_m));
+      const Eigen::Vector2d goal = tracker.toOdom(sec.end_m);
+      const Polar pg = polarFrom(pose, goal);
       const double free =
           corridorFree(scanPoints(scans), pg.bearing,
                        s.avoid.robot_radius_m + s.avoid.corridor_margin_m, s.avoid.max_range_m);
-      if (free >= pg.range) {
+      double bearing = pg.bearing, left = pg.range;
+      bool ok = free >= pg.range;
+      if (!ok && s.exec.detour) {
+        const double b = planTowards(goal);
+        // Only a short way round: a long one means the estimate sits behind a wall.
+        if (std::isfinite(b) && detour.length_m <= s.exec.dock_m + 1.5) {
+          ok = true;
+          bearing = b;
+          left =
+              std::max(0.0, detour.length_m -
+                                (detour.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm());
+        }
+      }
+      if (ok) {
         docking = true;
         if (avoider.active()) {
           avoider.reset();
+          endDetour();
           event({{"type", "avoid_end"}, {"side", "none"}, {"docking", true}});
         }
-        target_bearing = pg.bearing;
-        headFor(pg.bearing, std::clamp(pg.range / 0.6, 0.3, 1.0), v, w);  // slow in the last 0.6 m
+        target_bearing = bearing;
+        headFor(bearing, std::clamp(left / 0.6, 0.3, 1.0), v, w);  // slow in the last 0.6 m
         mode = "dock";
-        turn = turnOf(pg.bearing);
+        turn = turnOf(bearing);
       }
     }
     // Stuck recovery: the reactive layers can livelock (boxed in between furniture, the route
@@ -598,6 +633,7 @@ struct Executive::Impl {
       }
     }
     double front = 0;
+    bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
     if (docking || recovering) {
       if (docking) v = avoider.capSpeed(scans, v);
     } else if (!dev.ranges.empty()) {
@@ -618,11 +654,42 @@ struct Executive::Impl {
         if (tr && lm && tr->state == LmState::Tracking && atLandmark(att[0].k, *lm, tr->last_range))
           passLandmark(att[0].k, att[0].i, false);
       }
-      if (av.ended) event({{"type", "avoid_end"}, {"side", toString(av.side)}});
+      if (av.ended) {
+        endDetour();
+        event({{"type", "avoid_end"}, {"side", toString(av.side)}});
+      }
       if (av.active) {
-        v = av.v;
-        w = av.w;
-        mode = "avoid";
+        dodging = true;
+        // Something standing still: follow a way round planned on the grid, back to the route
+        // a few metres on. Something coming towards the robot (a person) is left to the
+        // reactive dodge, whose rules step out of its way.
+        // Once something has come towards the robot in this manoeuvre it stays reactive: the
+        // approach estimate drops while the robot backs off and turns, and a plan through
+        // the grid's picture of the person then led a robot straight into them.
+        if (av.started) moving_seen = false;
+        moving_seen |= av.approach_speed >= 0.25;
+        double b = std::numeric_limits<double>::quiet_NaN();
+        if (s.exec.detour && !moving_seen)
+          b = planTowards(tracker.lookahead(pose, s.exec.detour_ahead_m));
+        if (std::isfinite(b)) {
+          if (!detouring) {
+            detouring = true;
+            ++detours;
+            event({{"type", "detour_start"},
+                   {"length_m", detour.length_m},
+                   {"goal_odom", {detour.goal.x(), detour.goal.y()}},
+                   {"goal_moved", detour.goal_moved},
+                   {"section", k}});
+          }
+          headFor(b, 1.0, v, w);
+          v = avoider.capSpeed(scans, v);
+          mode = "detour";
+        } else {
+          endDetour();
+          v = av.v;
+          w = av.w;
+          mode = "avoid";
+        }
         turn = turnOf(w);
       } else {
         v = avoider.capSpeed(scans, v);
@@ -634,7 +701,7 @@ struct Executive::Impl {
     // The goal counts as blocked only when the robot cannot get within 0.6 m of it.
     const double blocked_m =
         k + 1 == tracker.count() ? std::min(0.6, s.exec.end_blocked_m) : s.exec.end_blocked_m;
-    if (mode == "avoid" && prog.to_end_m <= blocked_m && !sectionBlocked_) {
+    if (dodging && prog.to_end_m <= blocked_m && !sectionBlocked_) {
       // Blocked means the range sensors see something at or before the end point itself.
       const Polar pe = polarFrom(pose, tracker.toOdom(sec.end_m));
       const double r = rangeAt(pe.bearing);
@@ -690,6 +757,25 @@ struct Executive::Impl {
       row.front_free_m = front;
       obs->onTick(row);
     }
+  }
+
+  // Bearing [rad, robot frame] of the carrot on a path planned to `goal` (odometry frame),
+  // replanned every replan_s or when the goal moved; NaN when there is no way there.
+  double planTowards(const Eigen::Vector2d& goal) {
+    if (now - detour_t >= s.exec.replan_s - 1e-9 || (goal - detour_goal).norm() > 0.3) {
+      detour = planner.plan({pose.x, pose.y}, goal);
+      detour_t = now;
+      detour_goal = goal;
+    }
+    if (!detour.found) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Vector2d c =
+        LocalPlanner::carrot(detour, {pose.x, pose.y}, planner.params().carrot_m);
+    return polarFrom(pose, c).bearing;
+  }
+  void endDetour() {
+    if (!detouring) return;
+    detouring = false;
+    event({{"type", "detour_end"}});
   }
 
   // Sightings further than this are not ranged fixes (the laser along the bearing may hit
@@ -918,6 +1004,7 @@ ExecutiveSummary Executive::summary() const {
   s.perception_ms_max = I.perc_max;
   s.avoidance_manoeuvres = I.manoeuvres;
   s.recoveries = I.recoveries;
+  s.detours = I.detours;
   s.laser_odometry = I.lodo.stats();
   return s;
 }

@@ -219,6 +219,10 @@ std::vector<Eigen::Vector2d> SectionTracker::guidePointsOdom() const {
 }
 
 Eigen::Vector2d SectionTracker::lookahead(const hw::Pose2D& o) const {
+  return lookahead(o, params_.lookahead_m);
+}
+
+Eigen::Vector2d SectionTracker::lookahead(const hw::Pose2D& o, double distance_m) const {
   const auto pts = guidePointsOdom();
   if (finished()) return pts.back();
   const int k = current_;
@@ -234,7 +238,7 @@ Eigen::Vector2d SectionTracker::lookahead(const hw::Pose2D& o) const {
   for (int i = k; i + 1 < static_cast<int>(pts.size()); ++i) {
     const Eigen::Vector2d seg_end = pts[i + 1];
     while ((seg_end - p).norm() > 1e-9) {
-      if ((p - r).norm() >= params_.lookahead_m) return p;
+      if ((p - r).norm() >= distance_m) return p;
       const Eigen::Vector2d dir = seg_end - p;
       p = dir.norm() <= step ? seg_end : Eigen::Vector2d(p + dir.normalized() * step);
     }

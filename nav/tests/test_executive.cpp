@@ -111,6 +111,8 @@ TEST(Executive, AvoidsAStaticObstacleOnThePath) {
   const auto sum = s.run();
   EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
   EXPECT_GE(sum.avoidance_manoeuvres, 1);
+  EXPECT_GE(sum.detours, 1);  // a standing obstacle: the way round is planned on the grid
+  EXPECT_EQ(s.rec.count("detour_start"), sum.detours);
   EXPECT_GT(s.rec.min_clearance, 0.05);
   EXPECT_LT(s.distToGoal(), 0.6);
 }

@@ -315,8 +315,14 @@ struct Simulator::Impl {
         const double a = (k / double(rays - 1) - 0.5) * s.beam_width;
         r = std::min(r, castRay(bp, a, peds, S.max_range));
       }
+      // The scan has one mount, the robot's centre, for the whole ring: a range is reported
+      // from there, i.e. with the transducer's offset along its axis added (reporting it
+      // from the rim made every echo look 0.2 m closer than it is).
+      const double off = b.x * std::cos(b.yaw) + b.y * std::sin(b.yaw);
       s.angles.push_back(static_cast<float>(b.yaw));
-      s.ranges.push_back(noisy(r, S.min_range, S.max_range, g));
+      s.ranges.push_back(r >= S.max_range || r + off >= S.max_range
+                             ? static_cast<float>(S.max_range)
+                             : noisy(r + off, S.min_range, S.max_range, g));
     }
     return s;
   }

@@ -563,7 +563,9 @@ TEST(Range, LaserAndSonarAgainstAKnownWall) {
   ASSERT_TRUE(s.sonar().read(scan));
   EXPECT_EQ(scan.kind, hw::RangeScan::Kind::Sonar);
   ASSERT_EQ(scan.ranges.size(), 1u);
-  EXPECT_NEAR(scan.ranges[0], 4.95 - 2.0 - 0.2, 1e-4);
+  // From the robot's centre (the scan's mount), not from the transducer 0.2 m ahead of it.
+  EXPECT_NEAR(scan.mount.x, 0.0, 1e-12);
+  EXPECT_NEAR(scan.ranges[0], 4.95 - 2.0, 1e-4);
   EXPECT_GT(scan.beam_width, 0.0f);
 }
 
@@ -621,7 +623,7 @@ TEST(Range, PedestrianCrossingTheLaser) {
   // Sonar sees it too when it is in front.
   s.clock()->sleepUntil(9.0);
   ASSERT_TRUE(s.sonar().read(scan));
-  EXPECT_NEAR(scan.ranges[0], 5.0 - 0.25 - 2.2, 1e-3);
+  EXPECT_NEAR(scan.ranges[0], 5.0 - 0.25 - 2.0, 1e-3);  // from the robot's centre
 }
 
 TEST(Range, PedestrianVisibleInTheCamera) {

@@ -21,6 +21,7 @@
 #include "sketchnav/nav/avoidance.h"
 #include "sketchnav/nav/landmark_stage.h"
 #include "sketchnav/nav/laser_odometry.h"
+#include "sketchnav/nav/local_planner.h"
 #include "sketchnav/nav/perception.h"
 #include "sketchnav/nav/safety.h"
 #include "sketchnav/nav/sections.h"
@@ -90,6 +91,13 @@ struct ExecutiveParams {
   double stuck_m = 0.3;        // [m]
   double recover_m = 1.0;      // [m] then drive this far towards the most open direction
   double recover_s = 8;        // [s] (at most this long) and resume
+  // Detours (local_planner.h): when the avoider is dodging something that is not coming
+  // towards the robot, the robot follows a path planned on the laser's occupancy grid to the
+  // route point detour_ahead_m on, instead of the reactive dodge; and near the goal, with no
+  // free straight line to it, a path to the goal. Replanned every replan_s.
+  bool detour = true;
+  double detour_ahead_m = 3.0;  // [m]
+  double replan_s = 0.5;        // [s]
   template <class B>
   void bind(B& b) {
     b("tick_s", tick_s);
@@ -132,6 +140,9 @@ struct ExecutiveParams {
     b("stuck_m", stuck_m);
     b("recover_m", recover_m);
     b("recover_s", recover_s);
+    b("detour", detour);
+    b("detour_ahead_m", detour_ahead_m);
+    b("replan_s", replan_s);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };
@@ -145,12 +156,13 @@ struct NavSettings {
   AvoidParams avoid;
   SafetyParams safety;
   LaserOdometryParams laser_odometry;
+  PlannerParams planner;
   servo::TurnLawParams servo;
 };
 
 /// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*", "nav.locate.*",
-/// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "servo.*") over the defaults and
-/// validates.
+/// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "nav.planner.*", "servo.*") over the
+/// defaults and validates.
 NavSettings navSettingsFrom(const Config& config);
 
 /// One control tick, for telemetry.csv.
@@ -159,7 +171,8 @@ struct TelemetryRow {
   hw::Pose2D odom;
   double v_cmd = 0, w_cmd = 0;
   double servo_error = 0;  // x_t - x_d when servoing, NaN otherwise
-  std::string mode;  // follow | look | servo | dock | recover | avoid | stopped | done | failed
+  std::string mode;  // follow | look | servo | dock | recover | avoid | detour | stopped | done |
+                     // failed
   std::string turn;  // Left | Straight | Right
   int section = 0;
   std::string landmark;     // id of the attended landmark ("" when none)
@@ -196,6 +209,7 @@ struct ExecutiveSummary {
   double objectness_ms_mean = 0, features_ms_mean = 0, match_ms_mean = 0;
   int avoidance_manoeuvres = 0;
   int recoveries = 0;  // stuck recoveries
+  int detours = 0;     // detours planned round obstacles (local_planner.h)
   LaserOdometryStats laser_odometry;
   nlohmann::json toJson() const;
 };

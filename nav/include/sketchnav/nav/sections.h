@@ -130,6 +130,8 @@ class SectionTracker {
   /// The point (odometry frame) `lookahead_m` ahead of the robot's projection on the
   /// remaining route (continuing into the following sections, clamped at the goal).
   Eigen::Vector2d lookahead(const hw::Pose2D& odom) const;
+  /// The same with its own distance (the planner's detour goal lies further on).
+  Eigen::Vector2d lookahead(const hw::Pose2D& odom, double distance_m) const;
   /// The sketched route (guide points) in the odometry frame.
   std::vector<Eigen::Vector2d> guidePointsOdom() const;
 
