@@ -42,6 +42,9 @@ void ExecutiveParams::validate() const {
   require(detour_ahead_m > 0.5 && detour_ahead_m <= 10, "nav.detour_ahead_m",
           "must be in (0.5, 10] m");
   require(replan_s > 0, "nav.replan_s", "must be > 0");
+  require(same_class_gate_m >= 0, "nav.same_class_gate_m", "must be >= 0 (0 = off)");
+  require(final_look_range_m >= 0, "nav.final_look_range_m", "must be >= 0 (0 = off)");
+  require(final_look_s > 0, "nav.final_look_s", "must be > 0");
   require(fit_fixes == 0 || fit_fixes >= 3, "nav.fit_fixes", "must be 0 (off) or >= 3");
   require(fit_min_span_m >= 0, "nav.fit_min_span_m", "must be >= 0");
   require(fit_max_scale_change >= 0 && fit_max_scale_change < 1, "nav.fit_max_scale_change",
@@ -186,11 +189,18 @@ struct Executive::Impl {
   double detour_t = -1e300;
   Eigen::Vector2d detour_goal{1e300, 1e300};
   bool detouring = false;
-  bool moving_seen = false;  // the current manoeuvre has seen something come towards the robot
+  bool moving_seen = false;
+  // Final look: at the goal, a landmark of the last section never seen (too far so far) is
+  // looked for before arriving. Which one, since when, and whether it is over.
+  int fl_k = -1, fl_i = -1;
+  double fl_t = 0;
+  bool fl_done = false,
+       final_looking = false;  // the current manoeuvre has seen something come towards the robot
   int detours = 0;
   double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
+  std::vector<std::string> fixes_class;                  // class of each ("" for the start)
   std::vector<Eigen::Matrix2d> fixes_info;               // how well each was seen [1/m^2]
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
@@ -351,6 +361,7 @@ struct Executive::Impl {
         hold |= t.state == LmState::Tracking && now - t.last_seen <= s.exec.servo_hold_s + 0.5;
       if (hold && tracker.progress(pose).remaining_m < -s.exec.miss_slack_m) hold = false;
     }
+    final_looking = false;
     // At the goal: a landmark of the last section that was seen moves the goal when it is
     // passed (re-fit), so pass it first and judge arrival against the corrected goal.
     if (!hold && !tracker.finished() && tracker.current() + 1 == tracker.count() &&
@@ -362,6 +373,8 @@ struct Executive::Impl {
           passLandmark(kl, static_cast<int>(i), false);
       }
       if (status != RunStatus::Running) return;
+      final_looking = finalLook();
+      hold |= final_looking;
     }
     if (!hold && tracker.update(pose) > 0) closeSections(before);
     if (status != RunStatus::Running) return;
@@ -449,7 +462,8 @@ struct Executive::Impl {
         std::vector<Candidate> cands;
         std::vector<size_t> idx;
         for (size_t c = 0; c < all.size(); ++c)
-          if (!used[c]) cands.push_back(all[c]), idx.push_back(c);
+          if (!used[c] && !atEarlierFix(x.lm->class_name, *all[c].detection, all[c].range_m))
+            cands.push_back(all[c]), idx.push_back(c);
         const int ci =
             selectCandidate(cands, x.lm->class_name, x.pred.bearing, x.pred.range, s.select);
         if (ci < 0) continue;
@@ -720,6 +734,10 @@ struct Executive::Impl {
       goal_best_ = 1e300;
       goal_best_t_ = now;
     }
+    if (goal_settled && (final_looking = finalLook())) {
+      goal_settled = false;  // look for the last landmark first; it may move the goal
+      goal_best_t_ = now;
+    }
     if (goal_settled) {
       event({{"type", "goal_settled"}, {"to_end_m", prog.to_end_m}});
       tracker.advance();
@@ -740,6 +758,16 @@ struct Executive::Impl {
                                          std::to_string(prog.to_end_m).substr(0, 4) + " m away)");
         return;
       }
+    }
+    if (final_looking && fl_k >= 0) {
+      // Turn on the spot to where the sketch puts the landmark (perception attends it once it
+      // is within attend_bearing_deg).
+      const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
+      const double b = polarFrom(pose, tracker.toOdom(l.position_m)).bearing;
+      v = 0;
+      w = std::abs(b) < 0.1 ? 0.0 : s.exec.k_heading * b;
+      mode = "look";
+      turn = turnOf(w);
     }
     w = std::clamp(w, -s.exec.max_w, s.exec.max_w);
     dev.base->command(v, w);
@@ -776,6 +804,60 @@ struct Executive::Impl {
     if (!detouring) return;
     detouring = false;
     event({{"type", "detour_end"}});
+  }
+
+  // At the goal: whether to stay and look for a never-seen landmark of the last section within
+  // final_look_range_m (starts the look on the first call, ends it when the landmark is seen
+  // or after final_look_s).
+  bool finalLook() {
+    if (fl_done || tracker.finished() || s.exec.final_look_range_m <= 0) return false;
+    if (fl_k < 0) {
+      const int kl = tracker.count() - 1;
+      double best = s.exec.final_look_range_m;
+      for (size_t i = 0; i < tracks[kl].size(); ++i) {
+        const auto& t = tracks[kl][i];
+        if (t.state != LmState::Pending || t.frames_seen > 0) continue;
+        const auto& l = tracker.route().sections[kl].landmarks[i];
+        const double r = polarFrom(pose, tracker.toOdom(l.position_m)).range;
+        if (r <= best) best = r, fl_k = kl, fl_i = static_cast<int>(i);
+      }
+      if (fl_k < 0) {
+        fl_done = true;
+        return false;
+      }
+      fl_t = now;
+      const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
+      event({{"type", "final_look_start"}, {"id", l.id}, {"range_m", best}});
+    }
+    const auto& t = tracks[fl_k][fl_i];
+    const bool seen = t.state != LmState::Pending || t.frames_seen > 0;
+    if (seen || now - fl_t > s.exec.final_look_s) {
+      fl_done = true;
+      event({{"type", "final_look_end"},
+             {"id", tracker.route().sections[fl_k].landmarks[fl_i].id},
+             {"seen", seen}});
+      return false;
+    }
+    return true;
+  }
+
+  // Whether a detection of `cls` is where an earlier landmark of that class was fixed (the
+  // same object seen again, not the next one of a repeated class): its ranged point within
+  // same_class_gate_m of that fix, or without a usable range, its ray passing within half that.
+  bool atEarlierFix(const std::string& cls, const Detection& d, double range) const {
+    const Eigen::Vector2d o(pose.x, pose.y);
+    const Eigen::Vector2d dir(std::cos(pose.theta + d.bearing), std::sin(pose.theta + d.bearing));
+    for (size_t j = 1; j < fixes_odom.size(); ++j) {
+      if (fixes_class[j] != cls) continue;
+      const Eigen::Vector2d v = fixes_odom[j] - o;
+      if (range > 0 && range <= fixRange()) {
+        if ((o + range * dir - fixes_odom[j]).norm() < s.exec.same_class_gate_m) return true;
+      } else if (v.dot(dir) > 0 &&
+                 std::abs(dir.x() * v.y() - dir.y() * v.x()) < 0.5 * s.exec.same_class_gate_m) {
+        return true;
+      }
+    }
+    return false;
   }
 
   // Sightings further than this are not ranged fixes (the laser along the bearing may hit
@@ -821,7 +903,14 @@ struct Executive::Impl {
     // agree) vs where the sketch puts it: refit or rotate the route, then shift it, each by
     // its gain. A landmark that slid out of view when close was seen as well as one passed in
     // view, and the last landmark before the goal is often passed that way.
-    const LandmarkFix lf = locateLandmark(tr.sightings, s.locate);
+    LandmarkFix lf = locateLandmark(tr.sightings, s.locate);
+    // Located where an earlier landmark of the same class was: the sightings were of that one.
+    for (size_t j = 1; lf.ok && j < fixes_odom.size(); ++j)
+      if (fixes_class[j] == lm.class_name &&
+          (fixes_odom[j] - lf.position).norm() < s.exec.same_class_gate_m) {
+        lf.ok = false;
+        e["fix_rejected"] = "where an earlier " + lm.class_name + " was";
+      }
     if (lf.ok) {
       const Eigen::Vector2d seen = lf.position;
       e["fix_method"] = lf.triangulated ? "bearings" : "ranges";
@@ -838,6 +927,7 @@ struct Executive::Impl {
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
       fixes_info.push_back(lf.information);
+      fixes_class.push_back(lm.class_name);
       // With enough fixes spread far enough: refit rotation, scale and translation to the
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
       // part of the way to this one (hand-drawn maps are also locally distorted).
@@ -930,6 +1020,7 @@ void Executive::start() {
   I.fix_odom = I.tracker.toOdom(I.fix_route);
   I.fixes_route = {I.fix_route};
   I.fixes_odom = {I.fix_odom};
+  I.fixes_class = {""};
   I.fixes_info = {Eigen::Matrix2d::Identity() / (0.05 * 0.05)};  // the start: where it is put
   I.safety.start(I.t0);
   I.status = RunStatus::Running;

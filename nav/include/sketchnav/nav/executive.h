@@ -95,6 +95,18 @@ struct ExecutiveParams {
   // towards the robot, the robot follows a path planned on the laser's occupancy grid to the
   // route point detour_ahead_m on, instead of the reactive dodge; and near the goal, with no
   // free straight line to it, a path to the goal. Replanned every replan_s.
+  // A repeated class: a detection (or a fix) within this of where an earlier landmark of the
+  // same class was fixed is that landmark seen again, not the next one. A robot took the
+  // first of three Bravo cartons for the second, refitted the sketch to it (scale -12 %) and
+  // stopped 2.8 m from the goal.
+  double same_class_gate_m = 1.0;  // [m]
+  // At the goal, a landmark of the last section that was never seen (too far, or out of view
+  // on the way) and that the sketch puts within final_look_range_m: turn to it and look for up
+  // to final_look_s before arriving; seen, it is passed and the refit moves the goal. The
+  // goal is often extrapolated metres past the last landmark seen, and a missed last
+  // landmark was the commonest way to stop 0.5-0.8 m short. 0 = off.
+  double final_look_range_m = 4.0;  // [m]
+  double final_look_s = 5.0;        // [s]
   bool detour = true;
   double detour_ahead_m = 3.0;  // [m]
   double replan_s = 0.5;        // [s]
@@ -140,6 +152,9 @@ struct ExecutiveParams {
     b("stuck_m", stuck_m);
     b("recover_m", recover_m);
     b("recover_s", recover_s);
+    b("same_class_gate_m", same_class_gate_m);
+    b("final_look_range_m", final_look_range_m);
+    b("final_look_s", final_look_s);
     b("detour", detour);
     b("detour_ahead_m", detour_ahead_m);
     b("replan_s", replan_s);
