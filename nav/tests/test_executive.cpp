@@ -117,6 +117,44 @@ TEST(Executive, AvoidsAStaticObstacleOnThePath) {
   EXPECT_LT(s.distToGoal(), 0.6);
 }
 
+// A landmark of the last section out of the camera's view all the way (90 deg left of the
+// goal): the robot turns to it at the goal and looks before arriving.
+void lookBesideTheGoal(Scenario& s) {
+  s.route = makeRoute({{0, 0}, {6, 0}, {6, 5}}, {{0, "A", "cup", {7.0, 0.3}},
+                                                 {1, "B", "bin", {6.4, 6.2}},
+                                                 {1, "C", "box", {3.5, 5.3}}});
+  s.world.obstacles.push_back({{3.5, 5.0}, 0.15});
+  s.perception = std::make_unique<GeometricPerception>(
+      s.world, std::vector<TrueMark>{{"cup", {7.3, 0.5}}, {"bin", {6.6, 6.5}}, {"box", {3.5, 5.0}}});
+}
+
+TEST(Executive, LooksForAnUnseenLastLandmarkAtTheGoal) {
+  Scenario s;
+  lookBesideTheGoal(s);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  ASSERT_EQ(s.rec.count("final_look_start"), 1);
+  ASSERT_EQ(s.rec.count("final_look_end"), 1);
+  for (const auto& e : s.rec.events)
+    if (e["type"] == "final_look_end") {
+      EXPECT_EQ(e["id"], "C");
+      EXPECT_TRUE(e["seen"].get<bool>());
+    }
+  ASSERT_EQ(sum.landmarks.size(), 3u);
+  EXPECT_EQ(sum.landmarks[2].state, "passed");
+}
+
+TEST(Executive, WithoutTheFinalLookTheLastLandmarkIsMissed) {
+  Scenario s;
+  lookBesideTheGoal(s);
+  s.settings.exec.final_look_range_m = 0;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_EQ(s.rec.count("final_look_start"), 0);
+  ASSERT_EQ(sum.landmarks.size(), 3u);
+  EXPECT_NE(sum.landmarks[2].state, "passed");
+}
+
 TEST(Executive, StopsWithin200msOfADroppedCamera) {
   Scenario s(true, true, /*drop_camera=*/3.0);
   const auto sum = s.run();
