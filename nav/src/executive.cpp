@@ -189,13 +189,14 @@ struct Executive::Impl {
   double detour_t = -1e300;
   Eigen::Vector2d detour_goal{1e300, 1e300};
   bool detouring = false;
-  bool moving_seen = false;
-  // Final look: at the goal, a landmark of the last section never seen (too far so far) is
-  // looked for before arriving. Which one, since when, and whether it is over.
+  bool moving_seen = false;  // the current manoeuvre has seen something come towards the robot
+  // Final look: at the goal, a landmark never seen (too far so far) is looked for before
+  // arriving. Which one, since when, whether it had been missed, whether the look is over.
   int fl_k = -1, fl_i = -1;
   double fl_t = 0;
-  bool fl_done = false,
-       final_looking = false;  // the current manoeuvre has seen something come towards the robot
+  bool fl_was_missed = false;
+  bool fl_done = false;
+  bool final_looking = false;  // this tick
   int detours = 0;
   double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
@@ -357,8 +358,11 @@ struct Executive::Impl {
     bool hold = false;
     if (!tracker.finished()) {
       const int k0 = tracker.current();
-      for (const auto& t : tracks[k0])
+      for (size_t i = 0; i < tracks[k0].size(); ++i) {
+        const auto& t = tracks[k0][i];
+        if (k0 == fl_k && static_cast<int>(i) == fl_i && !fl_done) continue;  // final look's
         hold |= t.state == LmState::Tracking && now - t.last_seen <= s.exec.servo_hold_s + 0.5;
+      }
       if (hold && tracker.progress(pose).remaining_m < -s.exec.miss_slack_m) hold = false;
     }
     final_looking = false;
@@ -409,7 +413,14 @@ struct Executive::Impl {
       bool attend;
     };
     std::vector<Attended> att;
-    for (int kk = k; kk < std::min(k + 2, tracker.count()) && att.size() < 2; ++kk) {
+    if (final_looking) {
+      const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
+      const Polar p = polarFrom(pose, tracker.toOdom(l.position_m));
+      const bool a = std::abs(p.bearing) <= s.exec.attend_bearing_deg * M_PI / 180;
+      att.push_back({fl_k, fl_i, &l, &tracks[fl_k][fl_i], p, a});
+    }
+    for (int kk = k; !final_looking && kk < std::min(k + 2, tracker.count()) && att.size() < 2;
+         ++kk) {
       const auto& ss = tracker.route().sections[kk];
       for (size_t i = 0; i < ss.landmarks.size() && att.size() < 2; ++i) {
         auto& t = tracks[kk][i];
@@ -812,30 +823,42 @@ struct Executive::Impl {
   bool finalLook() {
     if (fl_done || tracker.finished() || s.exec.final_look_range_m <= 0) return false;
     if (fl_k < 0) {
-      const int kl = tracker.count() - 1;
+      // Any section's: a landmark a few metres before the goal was often missed on the way
+      // (out of recognition range, or out of view) and is within range from the goal.
       double best = s.exec.final_look_range_m;
-      for (size_t i = 0; i < tracks[kl].size(); ++i) {
-        const auto& t = tracks[kl][i];
-        if (t.state != LmState::Pending || t.frames_seen > 0) continue;
-        const auto& l = tracker.route().sections[kl].landmarks[i];
-        const double r = polarFrom(pose, tracker.toOdom(l.position_m)).range;
-        if (r <= best) best = r, fl_k = kl, fl_i = static_cast<int>(i);
-      }
+      for (int kl = 0; kl < tracker.count(); ++kl)
+        for (size_t i = 0; i < tracks[kl].size(); ++i) {
+          const auto& t = tracks[kl][i];
+          if (t.frames_seen > 0 || (t.state != LmState::Pending && t.state != LmState::Missed))
+            continue;
+          const auto& l = tracker.route().sections[kl].landmarks[i];
+          const double r = polarFrom(pose, tracker.toOdom(l.position_m)).range;
+          if (r <= best) best = r, fl_k = kl, fl_i = static_cast<int>(i);
+        }
       if (fl_k < 0) {
         fl_done = true;
         return false;
       }
       fl_t = now;
+      fl_was_missed = tracks[fl_k][fl_i].state == LmState::Missed;
+      tracks[fl_k][fl_i].state = LmState::Pending;  // a missed one is looked for again
       const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
       event({{"type", "final_look_start"}, {"id", l.id}, {"range_m", best}});
     }
     const auto& t = tracks[fl_k][fl_i];
-    const bool seen = t.state != LmState::Pending || t.frames_seen > 0;
-    if (seen || now - fl_t > s.exec.final_look_s) {
+    const bool seen = t.frames_seen > 0;
+    // Seen: a few frames for its bearings to cross (the fix), then passed.
+    const bool enough = t.frames_seen >= 3 || t.state == LmState::Passed;
+    if (enough || now - fl_t > s.exec.final_look_s) {
       fl_done = true;
-      event({{"type", "final_look_end"},
-             {"id", tracker.route().sections[fl_k].landmarks[fl_i].id},
-             {"seen", seen}});
+      const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
+      event({{"type", "final_look_end"}, {"id", l.id}, {"seen", seen}});
+      if (t.state == LmState::Tracking || (t.state == LmState::Pending && seen))
+        passLandmark(fl_k, fl_i, false);
+      else if (t.state == LmState::Pending && fl_was_missed)
+        tracks[fl_k][fl_i].state = LmState::Missed;  // as it was (counted then)
+      else if (t.state == LmState::Pending)
+        markMissed(fl_k, fl_i);
       return false;
     }
     return true;

@@ -100,11 +100,11 @@ struct ExecutiveParams {
   // first of three Bravo cartons for the second, refitted the sketch to it (scale -12 %) and
   // stopped 2.8 m from the goal.
   double same_class_gate_m = 1.0;  // [m]
-  // At the goal, a landmark of the last section that was never seen (too far, or out of view
-  // on the way) and that the sketch puts within final_look_range_m: turn to it and look for up
-  // to final_look_s before arriving; seen, it is passed and the refit moves the goal. The
-  // goal is often extrapolated metres past the last landmark seen, and a missed last
-  // landmark was the commonest way to stop 0.5-0.8 m short. 0 = off.
+  // At the goal, a landmark never seen (too far on the way, or out of view) that the sketch
+  // puts within final_look_range_m: turn to it and look for up to final_look_s before
+  // arriving; seen, it is passed and the refit moves the goal. The goal is often extrapolated
+  // metres past the last landmark seen, and a missed last landmark was the commonest way to
+  // stop 0.5-0.8 m short. 0 = off.
   double final_look_range_m = 4.0;  // [m]
   double final_look_s = 5.0;        // [s]
   bool detour = true;
