@@ -74,6 +74,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.safety, c, "nav.safety");
   applyConfig(s.laser_odometry, c, "nav.laser_odometry");
   applyConfig(s.planner, c, "nav.planner");
+  applyConfig(s.movers, c, "nav.movers");
   applyConfig(s.servo, c, "servo");
   return s;
 }
@@ -117,6 +118,7 @@ json ExecutiveSummary::toJson() const {
           {"avoidance_manoeuvres", avoidance_manoeuvres},
           {"recoveries", recoveries},
           {"detours", detours},
+          {"yields", yields},
           {"laser_odometry",
            {{"scans", laser_odometry.scans},
             {"aligned", laser_odometry.aligned},
@@ -158,6 +160,12 @@ struct Executive::Impl {
   SafetySupervisor safety;
   LaserOdometry lodo;
   LocalPlanner planner;
+  MoverTracker movers;
+  // The grid as it was 1.5-3 s ago, for the mover tracker (a person's own trace is not in it).
+  LocalPlanner grid_before, grid_snap;
+  double snap_t = -1e300;
+  bool yielding = false;
+  int yields = 0;
 
   RunStatus status = RunStatus::Idle;
   std::string reason;
@@ -214,7 +222,10 @@ struct Executive::Impl {
         avoider(st.avoid),
         safety(st.safety),
         lodo(st.laser_odometry),
-        planner(st.planner) {
+        planner(st.planner),
+        movers(st.movers),
+        grid_before(st.planner),
+        grid_snap(st.planner) {
     s.exec.validate();
     s.select.validate();
     s.locate.validate();
@@ -324,8 +335,17 @@ struct Executive::Impl {
       }
     }
     if (have_pose) pose = lodo.pose();
-    if (have_pose && s.exec.detour)
-      for (size_t i : fresh) planner.insert(pose, scans[i]);
+    if (have_pose && (s.exec.detour || s.movers.enabled)) {
+      for (size_t i : fresh) {
+        movers.update(pose, scans[i], grid_before);
+        planner.insert(pose, scans[i]);
+      }
+      if (now - snap_t >= 1.5) {
+        grid_before = std::move(grid_snap);
+        grid_snap = planner.snapshot();
+        snap_t = now;
+      }
+    }
     hw::Frame frame;
     bool have_frame = false;
     if (dev.camera && now + 1e-9 >= frame_stamp + s.exec.camera_period_s - 0.5 * s.exec.tick_s) {
@@ -425,6 +445,7 @@ struct Executive::Impl {
       for (size_t i = 0; i < ss.landmarks.size() && att.size() < 2; ++i) {
         auto& t = tracks[kk][i];
         if (t.state == LmState::Passed || t.state == LmState::Missed) continue;
+        if (!fl_done && kk == fl_k && static_cast<int>(i) == fl_i) continue;  // final look's
         if (kk == k &&
             prog.along_m > ss.landmarks[i].along_m * tracker.scale() + s.exec.miss_slack_m &&
             t.state == LmState::Pending) {
@@ -768,6 +789,37 @@ struct Executive::Impl {
         finish(RunStatus::Succeeded, "reached the end of the route (end point blocked, " +
                                          std::to_string(prog.to_end_m).substr(0, 4) + " m away)");
         return;
+      }
+    }
+    // Walking people: keep out of their lanes (movers.h). In one: step out sideways (backing
+    // only slowly and with room behind); about to enter one: wait, turning is harmless.
+    if (s.movers.enabled && !dev.ranges.empty() && status == RunStatus::Running) {
+      const auto adv = movers.advise(pose, v, w, s.exec.k_heading, s.exec.v_cruise);
+      if (adv.active) {
+        if (!adv.in_lane) {
+          v = 0;
+        } else if (adv.v >= 0) {
+          v = avoider.capSpeed(scans, adv.v);
+          w = adv.w;
+        } else {
+          const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
+          v = corridorFree(scanPoints(scans), M_PI, hwid, s.avoid.max_range_m) > 0.5
+                  ? -s.avoid.reverse_speed
+                  : 0.0;
+          w = adv.w;
+        }
+        mode = "yield";
+        turn = turnOf(w);
+        if (!yielding) {
+          yielding = true;
+          ++yields;
+          event({{"type", "yield_start"},
+                 {"in_lane", adv.in_lane},
+                 {"clearance_m", adv.clearance_m}});
+        }
+      } else if (yielding) {
+        yielding = false;
+        event({{"type", "yield_end"}});
       }
     }
     if (final_looking && fl_k >= 0) {
@@ -1119,6 +1171,7 @@ ExecutiveSummary Executive::summary() const {
   s.avoidance_manoeuvres = I.manoeuvres;
   s.recoveries = I.recoveries;
   s.detours = I.detours;
+  s.yields = I.yields;
   s.laser_odometry = I.lodo.stats();
   return s;
 }

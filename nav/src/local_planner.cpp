@@ -85,6 +85,18 @@ bool LocalPlanner::occupied(const Eigen::Vector2d& p) const {
          1.0 - params_.occupied_p;
 }
 
+LocalPlanner LocalPlanner::snapshot() const {
+  LocalPlanner c(params_);
+  c.impl_->grid = impl_->grid;
+  c.inserted_ = inserted_;
+  return c;
+}
+
+bool LocalPlanner::seenFree(const Eigen::Vector2d& p) const {
+  return impl_->grid.getPos(static_cast<float>(p.x()), static_cast<float>(p.y())) >
+         params_.occupied_p;
+}
+
 bool LocalPlanner::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                                 double clearance) const {
   const double c = params_.cell_m;

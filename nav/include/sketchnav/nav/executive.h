@@ -22,6 +22,7 @@
 #include "sketchnav/nav/landmark_stage.h"
 #include "sketchnav/nav/laser_odometry.h"
 #include "sketchnav/nav/local_planner.h"
+#include "sketchnav/nav/movers.h"
 #include "sketchnav/nav/perception.h"
 #include "sketchnav/nav/safety.h"
 #include "sketchnav/nav/sections.h"
@@ -172,11 +173,13 @@ struct NavSettings {
   SafetyParams safety;
   LaserOdometryParams laser_odometry;
   PlannerParams planner;
+  MoverParams movers;
   servo::TurnLawParams servo;
 };
 
 /// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*", "nav.locate.*",
-/// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "nav.planner.*", "servo.*") over the
+/// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "nav.planner.*", "nav.movers.*",
+/// "servo.*") over the
 /// defaults and validates.
 NavSettings navSettingsFrom(const Config& config);
 
@@ -225,6 +228,7 @@ struct ExecutiveSummary {
   int avoidance_manoeuvres = 0;
   int recoveries = 0;  // stuck recoveries
   int detours = 0;     // detours planned round obstacles (local_planner.h)
+  int yields = 0;      // times the robot kept out of a walking person's lane (movers.h)
   LaserOdometryStats laser_odometry;
   nlohmann::json toJson() const;
 };

@@ -80,8 +80,15 @@ class LocalPlanner {
   bool segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance) const;
   /// Whether the cell at `p` is an obstacle.
   bool occupied(const Eigen::Vector2d& p) const;
+  /// Whether the cell at `p` has been seen as free floor (a laser point there now is
+  /// something that moved in: movers.h).
+  bool seenFree(const Eigen::Vector2d& p) const;
   /// The point `dist` along `path` beyond the path point nearest to `at`.
   static Eigen::Vector2d carrot(const PlannedPath& path, const Eigen::Vector2d& at, double dist);
+
+  /// A deep copy (the mover tracker judges "seen free" against the grid of a few seconds ago,
+  /// before a walking person's own trace was marked).
+  LocalPlanner snapshot() const;
 
   int scansInserted() const { return inserted_; }
   const PlannerParams& params() const { return params_; }

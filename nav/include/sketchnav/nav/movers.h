@@ -1,0 +1,98 @@
+#pragma once
+// People walking: tracked from the laser, and their lanes kept clear.
+//
+// The reactive avoider judges motion only from the point closing the corridor ahead, so a
+// person crossing from the side, or walking up behind a robot that has stopped for something
+// else, is not seen coming; a simulated pedestrian (who, like a distracted one, does not step
+// aside) then walks into a robot standing in its lane. Here laser points are grouped into
+// person-sized clusters in the odometry frame and tracked from scan to scan; a track whose
+// points lie where the occupancy grid of a few seconds ago had seen free floor and that
+// moves faster than min_speed is a mover. Its lane is the capsule swept over horizon_s,
+// widened by the person's and the robot's radii and a margin. The executive keeps out of
+// lanes: it does not drive into one, and when it finds itself in one it steps out of it
+// sideways, away from the mover's line, rather than cross in front.
+#include <Eigen/Core>
+
+#include <vector>
+
+#include "sketchnav/hw/types.h"
+
+namespace sketchnav::nav {
+
+class LocalPlanner;
+
+struct MoverParams {
+  bool enabled = true;
+  double cluster_gap_m = 0.15;   // [m] consecutive beams further apart start a new cluster
+  double max_width_m = 0.8;      // [m] wider clusters are furniture or walls
+  double gate_m = 0.5;           // [m] a cluster this close to a track's prediction is it
+  double min_speed = 0.2;        // [m/s] slower tracks are not movers
+  int min_updates = 3;           // scans before a track's speed is trusted
+  double forget_s = 0.6;         // [s] a track not seen this long is dropped
+  double horizon_s = 5.0;        // [s] lane length: where the mover will be by then
+  double person_radius_m = 0.3;  // [m]
+  double margin_m = 0.15;        // [m] added to the person's and the robot's radii
+  double robot_radius_m = 0.2;   // [m]
+  double look_ahead_s = 1.5;     // [s] the robot's own motion checked against lanes
+  double range_m = 4.0;          // [m] movers further than this are ignored
+  template <class B>
+  void bind(B& b) {
+    b("enabled", enabled);
+    b("cluster_gap_m", cluster_gap_m);
+    b("max_width_m", max_width_m);
+    b("gate_m", gate_m);
+    b("min_speed", min_speed);
+    b("min_updates", min_updates);
+    b("forget_s", forget_s);
+    b("horizon_s", horizon_s);
+    b("person_radius_m", person_radius_m);
+    b("margin_m", margin_m);
+    b("robot_radius_m", robot_radius_m);
+    b("look_ahead_s", look_ahead_s);
+    b("range_m", range_m);
+  }
+  void validate() const;  // InputError "nav.movers.<field> = ...: ..."
+};
+
+struct Mover {
+  Eigen::Vector2d position{0, 0};  // odometry frame [m]
+  Eigen::Vector2d velocity{0, 0};  // [m/s]
+  int updates = 0;
+};
+
+/// What to do about the movers this tick.
+struct YieldAdvice {
+  bool active = false;     // a lane is in the way: replace the command with (v, w)
+  bool in_lane = false;    // the robot is inside a lane (stepping out)
+  double v = 0, w = 0;     // [m/s], [rad/s]
+  double clearance_m = 0;  // to the nearest mover's body
+};
+
+class MoverTracker {
+ public:
+  explicit MoverTracker(MoverParams params = {});
+  /// Updates the tracks from a laser scan taken at `robot` (odometry frame). `grid`: the
+  /// occupancy grid as it was a few seconds ago (LocalPlanner::snapshot), where the floor was
+  /// seen free before a walking person's own trace was marked.
+  void update(const hw::Pose2D& robot, const hw::RangeScan& laser, const LocalPlanner& grid);
+  /// Tracks moving faster than min_speed after min_updates scans.
+  std::vector<Mover> movers() const;
+  /// Advice for a robot at `robot` about to command (v, w): stop rather than enter a lane,
+  /// step out of one it is in. `k_heading`, `v_max`: how it turns and how fast it may go.
+  YieldAdvice advise(const hw::Pose2D& robot, double v, double w, double k_heading,
+                     double v_max) const;
+  const MoverParams& params() const { return p_; }
+
+ private:
+  struct Track {
+    Eigen::Vector2d pos{0, 0}, vel{0, 0};
+    double t = 0;
+    int updates = 0;
+    int free_hits = 0;       // updates whose points landed where the floor had been seen free
+    bool born_free = false;  // the first of them did
+  };
+  MoverParams p_;
+  std::vector<Track> tracks_;
+};
+
+}  // namespace sketchnav::nav

@@ -1,0 +1,191 @@
+#include "sketchnav/nav/movers.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/nav/local_planner.h"
+
+namespace sketchnav::nav {
+
+void MoverParams::validate() const {
+  require(cluster_gap_m > 0, "nav.movers.cluster_gap_m", "must be > 0");
+  require(max_width_m > 0, "nav.movers.max_width_m", "must be > 0");
+  require(gate_m > 0, "nav.movers.gate_m", "must be > 0");
+  require(min_speed > 0, "nav.movers.min_speed", "must be > 0");
+  require(min_updates >= 2, "nav.movers.min_updates", "must be >= 2");
+  require(forget_s > 0, "nav.movers.forget_s", "must be > 0");
+  require(horizon_s > 0 && horizon_s <= 20, "nav.movers.horizon_s", "must be in (0, 20] s");
+  require(person_radius_m > 0 && robot_radius_m > 0 && margin_m >= 0, "nav.movers.margin_m",
+          "radii must be > 0 and the margin >= 0");
+  require(look_ahead_s > 0, "nav.movers.look_ahead_s", "must be > 0");
+  require(range_m > 0, "nav.movers.range_m", "must be > 0");
+}
+
+MoverTracker::MoverTracker(MoverParams params) : p_(params) {
+  p_.validate();
+}
+
+namespace {
+double segDist(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d d = b - a;
+  const double l2 = d.squaredNorm();
+  const double t = l2 > 1e-12 ? std::clamp((p - a).dot(d) / l2, 0.0, 1.0) : 0.0;
+  return (a + t * d - p).norm();
+}
+}  // namespace
+
+void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
+                          const LocalPlanner& grid) {
+  if (!p_.enabled || s.kind != hw::RangeScan::Kind::Laser) return;
+  const double c = std::cos(robot.theta), sn = std::sin(robot.theta);
+  // Clusters of consecutive valid beams (odometry frame).
+  struct Cluster {
+    Eigen::Vector2d sum{0, 0}, first{0, 0}, last{0, 0};
+    int n = 0, free = 0;
+  };
+  std::vector<Cluster> clusters;
+  Cluster cur;
+  Eigen::Vector2d prev(0, 0);
+  bool have_prev = false;
+  auto close = [&]() {
+    if (cur.n > 0 && (cur.last - cur.first).norm() <= p_.max_width_m) clusters.push_back(cur);
+    cur = Cluster{};
+  };
+  const size_t n = std::min(s.angles.size(), s.ranges.size());
+  for (size_t i = 0; i < n; ++i) {
+    const double r = s.ranges[i];
+    if (!std::isfinite(r) || r >= s.max_range || r < s.min_range) {
+      close();
+      have_prev = false;
+      continue;
+    }
+    const double x = s.mount.x + r * std::cos(s.angles[i]);
+    const double y = s.mount.y + r * std::sin(s.angles[i]);
+    const Eigen::Vector2d w(robot.x + c * x - sn * y, robot.y + sn * x + c * y);
+    if (have_prev && (w - prev).norm() > p_.cluster_gap_m) close();
+    if (cur.n == 0) cur.first = w;
+    cur.last = w;
+    cur.sum += w;
+    ++cur.n;
+    cur.free += grid.seenFree(w);
+    prev = w;
+    have_prev = true;
+  }
+  close();
+
+  // Associate with the tracks' predictions (nearest first), then filter position and
+  // velocity (alpha-beta).
+  const double t = s.stamp;
+  std::vector<bool> used(tracks_.size(), false);
+  std::vector<Track> born;
+  for (const auto& cl : clusters) {
+    const Eigen::Vector2d z = cl.sum / cl.n;
+    // Where the beams hit is the near surface: the body's centre is further away.
+    const Eigen::Vector2d centre =
+        z + (z - Eigen::Vector2d(robot.x, robot.y)).normalized() * 0.5 * p_.person_radius_m;
+    int best = -1;
+    double bd = p_.gate_m;
+    for (size_t k = 0; k < tracks_.size(); ++k) {
+      if (used[k]) continue;
+      const Eigen::Vector2d pred = tracks_[k].pos + tracks_[k].vel * (t - tracks_[k].t);
+      const double d = (pred - centre).norm();
+      if (d < bd) bd = d, best = static_cast<int>(k);
+    }
+    const bool on_free = 2 * cl.free > cl.n;
+    if (best < 0) {
+      Track tr;
+      tr.pos = centre;
+      tr.t = t;
+      tr.updates = 1;
+      tr.free_hits = on_free;
+      tr.born_free = on_free;
+      born.push_back(tr);
+      continue;
+    }
+    used[best] = true;
+    Track& tr = tracks_[best];
+    const double dt = t - tr.t;
+    if (dt <= 1e-6) continue;
+    const Eigen::Vector2d pred = tr.pos + tr.vel * dt;
+    const Eigen::Vector2d res = centre - pred;
+    tr.pos = pred + 0.6 * res;
+    tr.vel += (0.3 / dt) * res;
+    tr.t = t;
+    ++tr.updates;
+    tr.free_hits += on_free;
+  }
+  tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
+                               [&](const Track& tr) { return t - tr.t > p_.forget_s; }),
+                tracks_.end());
+  tracks_.insert(tracks_.end(), born.begin(), born.end());
+}
+
+std::vector<Mover> MoverTracker::movers() const {
+  std::vector<Mover> out;
+  for (const auto& tr : tracks_)
+    // First seen on floor seen free, or often stepping onto it (a walking person keeps
+    // entering cells seen free; a wall or a table edge is where the grid saw something), at a
+    // walking pace (a cluster sliding along a wall as the beams sweep it is "fast").
+    if ((tr.born_free || 3 * tr.free_hits >= tr.updates) && tr.updates >= p_.min_updates &&
+        tr.vel.norm() >= p_.min_speed && tr.vel.norm() <= 2.5)
+      out.push_back({tr.pos, tr.vel, tr.updates});
+  return out;
+}
+
+YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, double k_heading,
+                                 double v_max) const {
+  YieldAdvice a;
+  if (!p_.enabled) return a;
+  const double R = p_.person_radius_m + p_.robot_radius_m + p_.margin_m;
+  const Eigen::Vector2d P(robot.x, robot.y);
+  a.clearance_m = 1e9;
+  for (const auto& m : movers()) {
+    if ((m.position - P).norm() > p_.range_m) continue;
+    a.clearance_m =
+        std::min(a.clearance_m, (m.position - P).norm() - p_.person_radius_m - p_.robot_radius_m);
+    const Eigen::Vector2d A = m.position, B = m.position + m.velocity * p_.horizon_s;
+    if (segDist(P, A, B) < R) {
+      // In its lane: step out sideways, on the side of its line the robot is already on
+      // (crossing in front of it is how near-misses happen).
+      const Eigen::Vector2d u = m.velocity.normalized();
+      const double side = u.x() * (P - A).y() - u.y() * (P - A).x() >= 0 ? 1.0 : -1.0;
+      const Eigen::Vector2d out(-u.y() * side, u.x() * side);
+      double err = std::atan2(out.y(), out.x()) - robot.theta;
+      err = std::atan2(std::sin(err), std::cos(err));
+      // Backing out is as good as driving out when the way out is behind.
+      double dir = 1.0;
+      if (std::abs(err) > 100 * M_PI / 180) {
+        dir = -1.0;
+        err = std::atan2(std::sin(err + M_PI), std::cos(err + M_PI));
+      }
+      a.active = a.in_lane = true;
+      a.w = k_heading * err;
+      a.v = std::abs(err) < M_PI / 3 ? dir * v_max * std::cos(err) : 0.0;
+      return a;
+    }
+  }
+  // Not in a lane: would the command take the robot into one within look_ahead_s?
+  if (v <= 0) return a;
+  for (const auto& m : movers()) {
+    if ((m.position - P).norm() > p_.range_m) continue;
+    double x = robot.x, y = robot.y, th = robot.theta;
+    for (double t = 0.1; t <= p_.look_ahead_s + 1e-9; t += 0.1) {
+      x += v * 0.1 * std::cos(th);
+      y += v * 0.1 * std::sin(th);
+      th += w * 0.1;
+      // The lane as it will be then: the mover has moved on too.
+      const Eigen::Vector2d A = m.position + m.velocity * t;
+      const Eigen::Vector2d B = m.position + m.velocity * p_.horizon_s;
+      if (segDist({x, y}, A, B) < R) {
+        a.active = true;
+        a.v = 0;  // let it pass; turning on the spot is harmless
+        a.w = w;
+        return a;
+      }
+    }
+  }
+  return a;
+}
+
+}  // namespace sketchnav::nav

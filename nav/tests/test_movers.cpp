@@ -1,0 +1,95 @@
+// People from the laser: a walking person becomes a mover with its velocity, furniture does
+// not (also while the robot drives past it); the yield advice steps out of a lane on the
+// robot's side and stops short of entering one.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "scan_sim.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/nav/local_planner.h"
+#include "sketchnav/nav/movers.h"
+
+using namespace sketchnav;
+using namespace sketchnav::nav;
+using namespace sketchnav::nav::test;
+
+namespace {
+// The robot at `robot` watches the empty room (the floor is seen free), then a person walks
+// from `from` with `vel` for `secs` at 10 Hz.
+MoverTracker watch(LocalPlanner& grid, const hw::Pose2D& robot, Eigen::Vector2d from,
+                   Eigen::Vector2d vel, double secs, std::vector<Box> extra = {}) {
+  auto boxes = room();
+  boxes.insert(boxes.end(), extra.begin(), extra.end());
+  for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
+  MoverTracker tr;
+  const LocalPlanner before = grid.snapshot();  // the grid before the person walked in
+  for (double t = 0.5; t <= 0.5 + secs + 1e-9; t += 0.1) {
+    const Eigen::Vector2d p = from + vel * (t - 0.5);
+    const auto s = scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t);
+    tr.update(robot, s, before);
+    grid.insert(robot, s);
+  }
+  return tr;
+}
+}  // namespace
+
+TEST(Movers, AWalkingPersonIsAMoverWithItsVelocity) {
+  LocalPlanner grid;
+  const auto tr = watch(grid, {0, 0, 0}, {3.0, 2.0}, {0.0, -0.4}, 3.0);
+  const auto m = tr.movers();
+  ASSERT_EQ(m.size(), 1u);
+  EXPECT_NEAR(m[0].velocity.x(), 0.0, 0.1);
+  EXPECT_NEAR(m[0].velocity.y(), -0.4, 0.1);
+  EXPECT_NEAR(m[0].position.y(), 2.0 - 0.4 * 3.0, 0.25);
+}
+
+TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
+  LocalPlanner grid;
+  MoverTracker tr;
+  auto boxes = room();
+  boxes.push_back({3, 1.0, 0.25, 0.25});  // a person-sized box
+  LocalPlanner before = grid.snapshot();
+  for (double t = 0; t <= 4.0 + 1e-9; t += 0.1) {
+    const hw::Pose2D robot{0.3 * t, 0, 0.1 * std::sin(t)};
+    const auto s = scanAt(robot, boxes, {}, t);
+    tr.update(robot, s, before);
+    grid.insert(robot, s);
+    if (std::fmod(t + 1e-9, 1.0) < 0.05) before = grid.snapshot();  // as the executive does
+  }
+  EXPECT_TRUE(tr.movers().empty());
+}
+
+TEST(Movers, InTheLaneTheRobotStepsOutOnItsOwnSide) {
+  LocalPlanner grid;
+  // A person 2.5 m ahead walking straight at the robot, slightly to the robot's left.
+  const auto tr = watch(grid, {0, 0, 0}, {3.2, 0.15}, {-0.4, 0.0}, 2.0);
+  ASSERT_EQ(tr.movers().size(), 1u);
+  const auto a = tr.advise({0, 0, 0}, 0.3, 0.0, 1.5, 0.3);
+  ASSERT_TRUE(a.active);
+  EXPECT_TRUE(a.in_lane);
+  EXPECT_LT(a.w, 0.0);  // the person passes on the left: step out to the right
+}
+
+TEST(Movers, TheRobotDoesNotDriveIntoALane) {
+  LocalPlanner grid;
+  // A person crossing 0.8 m ahead from left to right; the robot drives straight on.
+  const auto tr = watch(grid, {0, 0, 0}, {0.8, 2.5}, {0.0, -0.4}, 1.0);
+  ASSERT_EQ(tr.movers().size(), 1u);
+  const auto a = tr.advise({0, 0, 0}, 0.3, 0.0, 1.5, 0.3);
+  ASSERT_TRUE(a.active);
+  EXPECT_FALSE(a.in_lane);
+  EXPECT_EQ(a.v, 0.0);
+  // Turned away from the crossing, the same command is fine.
+  EXPECT_FALSE(tr.advise({0, 0, M_PI}, 0.3, 0.0, 1.5, 0.3).active);
+}
+
+TEST(Movers, OffMeansNoAdvice) {
+  MoverParams p;
+  p.enabled = false;
+  MoverTracker tr(p);
+  EXPECT_FALSE(tr.advise({0, 0, 0}, 0.3, 0.0, 1.5, 0.3).active);
+  p.enabled = true;
+  p.min_updates = 1;
+  EXPECT_THROW(MoverTracker{p}, InputError);
+}
