@@ -4,7 +4,8 @@
 // (turned `--turn` degrees away) renders one frame (default noise); perception is asked for the
 // landmark's class with a hint: its true bearing and range, perturbed by `--hint-bearing`
 // degrees and `--hint-range` (relative). Prints, per setting and distance, how many landmarks
-// were recognised and the time per frame. Not a timed test: run by hand, e.g.
+// were recognised, the time per frame, and false detections when another landmark's class is
+// hinted at it. Not a timed test: run by hand, e.g.
 //   bench_perception --angle 0,40 --dist 2,3,4,5,6
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -109,7 +110,7 @@ Options parse(int argc, char** argv) {
 }
 
 struct Cell {
-  int n = 0, found = 0, fovea_found = 0, looks = 0;
+  int n = 0, found = 0, fovea_found = 0, looks = 0, wrong = 0;
   double normal_ms = 0, fovea_ms = 0, bearing_err_deg = 0;
 };
 
@@ -154,7 +155,7 @@ int main(int argc, char** argv) {
   std::printf("hint: bearing %+.1f deg, range %+.0f %%; robot turned %+.1f deg\n",
               o.hint_bearing_deg, 100 * o.hint_range, o.turn_deg);
   std::printf("%6s %6s | %-24s | %-34s | %s\n", "angle", "dist", "fovea off: found  ms",
-              "fovea on: found (by fovea) looks", "fovea ms/look  |bearing err| deg");
+              "fovea on: found (by fovea) looks", "fovea ms/look  |bearing err| deg  false");
   for (const double ang : o.angles) {
     for (const double dist : o.dists) {
       Cell c0, c1;
@@ -179,6 +180,13 @@ int main(int argc, char** argv) {
                                                  true_range * (1 + o.hint_range)}};
         const auto r0 = p_off.observe(f, K, look);
         const auto r1 = p_on.observe(f, K, look);
+        // Another landmark's class hinted at this one: any detection of it is false.
+        const std::string& other =
+            world.landmarks[(&lm - &world.landmarks[0] + 1) % world.landmarks.size()].class_name;
+        std::vector<nav::LookFor> wrong_look = look;
+        wrong_look[0].class_name = other;
+        for (const auto& d : p_on.observe(f, K, wrong_look).detections)
+          c1.wrong += d.class_name == other;
         int inliers = 0;
         auto has = [&](const nav::Observation& ob, double* bearing) {
           for (const auto& d : ob.detections)
@@ -215,13 +223,16 @@ int main(int argc, char** argv) {
                        lm.id.c_str(), lm.class_name.c_str(), ang, dist, f0, f1, inliers,
                        r1.timing.fovea_looks, r1.timing.fovea_ms);
       }
-      std::printf("%6.0f %6.1f | %5d/%d %12.1f   | %5d/%d (%d) %14d   | %8.1f %12.2f   %s\n", ang,
-                  dist, c0.found, c0.n, c0.normal_ms / c0.n, c1.found, c1.n, c1.fovea_found,
+      std::printf("%6.0f %6.1f | %5d/%d %12.1f   | %5d/%d (%d) %14d   | %8.1f %12.2f %7d   %s\n",
+                  ang, dist, c0.found, c0.n, c0.normal_ms / c0.n, c1.found, c1.n, c1.fovea_found,
                   c1.looks, c1.looks ? c1.fovea_ms / c1.looks : 0.0,
-                  c1.fovea_found ? c1.bearing_err_deg / c1.fovea_found : 0.0, per_lm.c_str());
+                  c1.fovea_found ? c1.bearing_err_deg / c1.fovea_found : 0.0, c1.wrong,
+                  per_lm.c_str());
       std::fflush(stdout);
     }
   }
-  std::printf("per landmark L1..L8: N = normal pass, F = fovea only, - = not recognised\n");
+  std::printf(
+      "false: detections of another landmark's class hinted at this one (fovea on)\n"
+      "per landmark L1..L8: N = normal pass, F = fovea only, - = not recognised\n");
   return 0;
 }

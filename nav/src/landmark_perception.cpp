@@ -35,6 +35,7 @@ void PerceptionParams::validate() const {
           "must be in [1, 8]");
   require(fovea_max_side >= 64, "nav.perception.fovea_max_side", "must be >= 64 px");
   require(fovea_max_features >= 0, "nav.perception.fovea_max_features", "must be >= 0");
+  require(fovea_max_looks >= 0, "nav.perception.fovea_max_looks", "must be >= 0");
 }
 
 Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
@@ -183,6 +184,7 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
     if (std::abs(off_axis) >= M_PI / 2) continue;
     const double u = K.cx + K.fx * std::tan(off_axis);
     if (!(u >= 0 && u < img.cols)) continue;
+    if (ob.timing.fovea_looks >= P.fovea_max_looks) break;  // the per-frame time budget
     looked.push_back(l.class_name);
 
     // Upscale distant landmarks to the pixel size they have at fovea_ref_range_m.

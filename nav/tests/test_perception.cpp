@@ -189,6 +189,26 @@ TEST_F(FoveaTest, NoSecondLookWhenTheNormalPassFindsIt) {
   EXPECT_DOUBLE_EQ(d.bearing, d0.bearing);
 }
 
+// fovea_max_looks bounds the time per frame: hints are served in order.
+TEST_F(FoveaTest, AtMostMaxLooksInHintOrder) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 64, 470, 210, 11);
+  const std::vector<LookFor> look = {{kOther, bearingOf(470), 3.0}, {kTarget, bearingOf(470), 3.0}};
+  LandmarkPerception one(model_, params(true));
+  const Observation o1 = one.observe(f, K, look);
+  EXPECT_EQ(o1.timing.fovea_looks, 1);
+  EXPECT_TRUE(o1.detections.empty());
+  PerceptionParams p = params(true);
+  p.fovea_max_looks = 2;
+  LandmarkPerception two(model_, p);
+  const Observation o2 = two.observe(f, K, look);
+  EXPECT_EQ(o2.timing.fovea_looks, 2);
+  EXPECT_EQ(countClass(o2, kTarget), 1);
+  EXPECT_EQ(countClass(o2, kOther), 0);
+}
+
 // The camera pan moves the predicted column: a hint in the robot frame is found with a
 // panned camera, and the bearing includes the pan.
 TEST_F(FoveaTest, CameraYawShiftsThePredictedColumn) {
@@ -248,6 +268,7 @@ TEST(PerceptionParamsTest, FoveaFieldsAreValidated) {
   bad([](PerceptionParams& p) { p.fovea_max_features = -1; }, "fovea_max_features");
   bad([](PerceptionParams& p) { p.fovea_min_range_m = -1; }, "fovea_min_range_m");
   bad([](PerceptionParams& p) { p.fovea_max_range_m = 0; }, "fovea_max_range_m");
+  bad([](PerceptionParams& p) { p.fovea_max_looks = -1; }, "fovea_max_looks");
 }
 
 }  // namespace

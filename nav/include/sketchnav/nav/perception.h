@@ -98,6 +98,8 @@ struct PerceptionParams {
   double fovea_max_upscale = 3.0;  // upscale at most this, in [1, 8]
   int fovea_max_side = 640;        // [px] the upscaled crop's longer side at most this
   int fovea_max_features = 1000;   // strongest keypoints kept in the crop (0 = all)
+  int fovea_max_looks = 1;         // second looks per frame at most, in hint order (the
+                                   // executive lists the landmark it servos on first)
   template <class B>
   void bind(B& b) {
     b("max_windows", max_windows);
@@ -119,6 +121,7 @@ struct PerceptionParams {
     b("fovea_max_upscale", fovea_max_upscale);
     b("fovea_max_side", fovea_max_side);
     b("fovea_max_features", fovea_max_features);
+    b("fovea_max_looks", fovea_max_looks);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
 };
