@@ -107,16 +107,16 @@ TEST_F(FoveaTest, ModelHasBothClasses) {
   EXPECT_GE(model_->classId(kTarget), 0);
 }
 
-// The landmark pasted 64 px wide (a 0.4 m carton ~3.5 m away at 554 px focal length: the
-// normal pass sees it 40 px wide), at the right edge (the crop is shifted to stay inside the
-// image) and on the left of the frame.
+// The landmark pasted 80 px wide (a 0.4 m carton ~2.8 m away at 554 px focal length: the
+// normal pass sees it 50 px wide and finds nothing), at the right edge (the crop is shifted to
+// stay inside the image) and on the left of the frame.
 TEST_F(FoveaTest, FindsASmallLandmarkWhereTheHintPointsWithItsFullFrameBearing) {
   const cv::Mat photo = cv::imread(iconic(kTarget));
   ASSERT_FALSE(photo.empty());
   for (const double u : {600.0, 150.0}) {
     SCOPED_TRACE("landmark at column " + std::to_string(u));
     hw::Frame f;
-    f.image = sceneWith(photo, 64, u, 210, 11);
+    f.image = sceneWith(photo, 80, u, 210, 11);
     const double bearing = bearingOf(u);
     const std::vector<LookFor> look = {{kTarget, bearing, 3.0}};  // upscaled x1.5
 
@@ -155,7 +155,7 @@ TEST_F(FoveaTest, NotFoundWhereTheHintDoesNotPoint) {
   const cv::Mat photo = cv::imread(iconic(kTarget));
   ASSERT_FALSE(photo.empty());
   hw::Frame f;
-  f.image = sceneWith(photo, 64, 470, 210, 11);
+  f.image = sceneWith(photo, 80, 470, 210, 11);
   LandmarkPerception foveal(model_, params(true));
   // The crop around the other half of the image does not contain it.
   const Observation ob = foveal.observe(f, K, std::vector<LookFor>{{kTarget, bearingOf(150), 3.0}});
@@ -194,7 +194,7 @@ TEST_F(FoveaTest, AtMostMaxLooksInHintOrder) {
   const cv::Mat photo = cv::imread(iconic(kTarget));
   ASSERT_FALSE(photo.empty());
   hw::Frame f;
-  f.image = sceneWith(photo, 64, 470, 210, 11);
+  f.image = sceneWith(photo, 80, 470, 210, 11);
   const std::vector<LookFor> look = {{kOther, bearingOf(470), 3.0}, {kTarget, bearingOf(470), 3.0}};
   LandmarkPerception one(model_, params(true));
   const Observation o1 = one.observe(f, K, look);
@@ -215,7 +215,7 @@ TEST_F(FoveaTest, CameraYawShiftsThePredictedColumn) {
   const cv::Mat photo = cv::imread(iconic(kTarget));
   ASSERT_FALSE(photo.empty());
   hw::Frame f;
-  f.image = sceneWith(photo, 64, 470, 210, 11);
+  f.image = sceneWith(photo, 80, 470, 210, 11);
   PerceptionParams p = params(true);
   p.camera_yaw = 0.3;
   LandmarkPerception foveal(model_, p);
