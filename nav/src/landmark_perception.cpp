@@ -1,5 +1,8 @@
 // The real perception: objectness windows -> RootSIFT matching of each window against the
-// expected classes' database photos (ratio test + RANSAC homography) -> servo feature.
+// expected classes' database photos (ratio test + RANSAC homography) -> servo feature; with
+// LookFor hints, a foveal second look at a hinted class the normal pass missed.
+#include <opencv2/imgproc.hpp>
+
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -21,6 +24,27 @@ void PerceptionParams::validate() const {
   require(merge_iou > 0 && merge_iou <= 1, "nav.perception.merge_iou", "must be in (0, 1]");
   require(frame_max_side >= 64, "nav.perception.frame_max_side", "must be >= 64 px");
   require(frame_max_features >= 0, "nav.perception.frame_max_features", "must be >= 0");
+  require(fovea_min_range_m >= 0, "nav.perception.fovea_min_range_m", "must be >= 0 m");
+  require(fovea_max_range_m > fovea_min_range_m, "nav.perception.fovea_max_range_m",
+          "must be > fovea_min_range_m");
+  require(fovea_width > 0 && fovea_width <= 1, "nav.perception.fovea_width", "must be in (0, 1]");
+  require(fovea_height > 0 && fovea_height <= 1, "nav.perception.fovea_height",
+          "must be in (0, 1]");
+  require(fovea_ref_range_m > 0, "nav.perception.fovea_ref_range_m", "must be > 0 m");
+  require(fovea_max_upscale >= 1 && fovea_max_upscale <= 8, "nav.perception.fovea_max_upscale",
+          "must be in [1, 8]");
+  require(fovea_max_side >= 64, "nav.perception.fovea_max_side", "must be >= 64 px");
+  require(fovea_max_features >= 0, "nav.perception.fovea_max_features", "must be >= 0");
+  require(fovea_max_looks >= 0, "nav.perception.fovea_max_looks", "must be >= 0");
+}
+
+Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                                const std::vector<LookFor>& look_for) {
+  std::vector<std::string> classes;
+  for (const auto& l : look_for)
+    if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
+      classes.push_back(l.class_name);
+  return observe(frame, k, classes);
 }
 
 struct LandmarkPerception::Impl {
@@ -47,6 +71,32 @@ double iou(const cv::Rect& a, const cv::Rect& b) {
   const double u = a.area() + b.area() - i;
   return u > 0 ? i / u : 0;
 }
+
+landmarks::MatchParams matchParams(const PerceptionParams& P) {
+  landmarks::MatchParams mp;
+  mp.ratio = P.ratio;
+  mp.min_inliers = P.min_inliers;
+  mp.max_photos = P.max_photos;
+  return mp;
+}
+
+// A match (in frame pixels) as a Detection; false when it gives no servo offset.
+bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const cv::Rect& window,
+                 int frame_cols, const hw::Intrinsics& K, const PerceptionParams& P, Detection& d) {
+  const auto off = landmarks::servoOffset(m, frame_cols);
+  if (!off.valid) return false;
+  d.class_name = cls;
+  d.window = window;
+  d.inliers = m.inliers;
+  d.confidence = m.confidence;
+  // Servo feature in normalised coordinates (doc/conventions.md). x_t: where the object
+  // is; x_d such that x_t - x_d is the chosen offset measure.
+  d.x_t = K.normalisedX(off.object_u);
+  const double err_px = P.paper_offset ? off.paper_offset_px : off.offset_px;
+  d.x_d = d.x_t - err_px / K.fx;
+  d.bearing = P.camera_yaw - std::atan(d.x_t);
+  return true;
+}
 }  // namespace
 
 Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
@@ -71,10 +121,7 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
   ob.timing.features_ms = msSince(t);
 
   t = clk::now();
-  landmarks::MatchParams mp;
-  mp.ratio = P.ratio;
-  mp.min_inliers = P.min_inliers;
-  mp.max_photos = P.max_photos;
+  const landmarks::MatchParams mp = matchParams(P);
   std::vector<cv::Rect> boxes;
   for (const auto& w : windows) boxes.push_back(w.box);
   if (P.whole_frame) boxes.push_back(cv::Rect());  // empty = the whole frame
@@ -84,19 +131,10 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
     for (const auto& box : boxes) {
       const auto m = landmarks::match(model, feats, box, cls, mp);
       if (!m.matched) continue;
-      const auto off = landmarks::servoOffset(m, frame.image.cols);
-      if (!off.valid) continue;
       Detection d;
-      d.class_name = cls;
-      d.window = box.area() > 0 ? box : cv::Rect(0, 0, frame.image.cols, frame.image.rows);
-      d.inliers = m.inliers;
-      d.confidence = m.confidence;
-      // Servo feature in normalised coordinates (doc/conventions.md). x_t: where the object
-      // is; x_d such that x_t - x_d is the chosen offset measure.
-      d.x_t = K.normalisedX(off.object_u);
-      const double err_px = P.paper_offset ? off.paper_offset_px : off.offset_px;
-      d.x_d = d.x_t - err_px / K.fx;
-      d.bearing = P.camera_yaw - std::atan(d.x_t);
+      const cv::Rect window =
+          box.area() > 0 ? box : cv::Rect(0, 0, frame.image.cols, frame.image.rows);
+      if (!toDetection(m, cls, window, frame.image.cols, K, P, d)) continue;
       // The same landmark seen through overlapping windows is one detection (most inliers).
       bool merged = false;
       for (auto& f : found)
@@ -112,6 +150,92 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
   std::sort(ob.detections.begin(), ob.detections.end(),
             [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
   ob.timing.match_ms = msSince(t);
+  ob.timing.total_ms = msSince(t0);
+  return ob;
+}
+
+Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
+                                        const std::vector<LookFor>& look_for) {
+  using clk = std::chrono::steady_clock;
+  const auto& P = impl_->p;
+  const auto& model = *impl_->model;
+  const auto t0 = clk::now();
+  std::vector<std::string> classes;
+  for (const auto& l : look_for)
+    if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
+      classes.push_back(l.class_name);
+  Observation ob = observe(frame, K, classes);
+  if (!P.fovea || frame.image.empty()) return ob;
+
+  const auto tf = clk::now();
+  const cv::Mat& img = frame.image;
+  const landmarks::MatchParams mp = matchParams(P);
+  std::vector<std::string> looked;  // one second look per class
+  for (const auto& l : look_for) {
+    if (!std::isfinite(l.bearing) || model.classId(l.class_name) < 0) continue;
+    if (std::isfinite(l.range) && (l.range < P.fovea_min_range_m || l.range > P.fovea_max_range_m))
+      continue;
+    const auto seen = [&](const Detection& d) { return d.class_name == l.class_name; };
+    if (std::any_of(ob.detections.begin(), ob.detections.end(), seen)) continue;
+    if (std::find(looked.begin(), looked.end(), l.class_name) != looked.end()) continue;
+    // Predicted image column (bearing = camera_yaw - atan(x)); behind the camera or outside
+    // the image: nothing to look at.
+    const double off_axis = std::remainder(P.camera_yaw - l.bearing, 2 * M_PI);
+    if (std::abs(off_axis) >= M_PI / 2) continue;
+    const double u = K.cx + K.fx * std::tan(off_axis);
+    if (!(u >= 0 && u < img.cols)) continue;
+    if (ob.timing.fovea_looks >= P.fovea_max_looks) break;  // the per-frame time budget
+    looked.push_back(l.class_name);
+
+    // Upscale distant landmarks to the pixel size they have at fovea_ref_range_m.
+    double scale = 1;
+    if (std::isfinite(l.range) && l.range > 0)
+      scale = std::clamp(l.range / P.fovea_ref_range_m, 1.0, P.fovea_max_upscale);
+    // The crop: centred on the predicted column (shifted to stay inside the image) and
+    // vertically (the landmark's height above the floor is not predicted). A nearer landmark
+    // can be further above or below the image centre, so the crop is taller: the frame's
+    // height / upscale, at least fovea_height of the frame.
+    const int cw = std::clamp(static_cast<int>(std::lround(P.fovea_width * img.cols)), 1, img.cols);
+    const double tall = std::max(P.fovea_height, 1 / scale) * img.rows;
+    const int ch = std::clamp(static_cast<int>(std::lround(tall)), 1, img.rows);
+    const int x0 = std::clamp(static_cast<int>(std::lround(u - 0.5 * cw)), 0, img.cols - cw);
+    const cv::Rect crop(x0, (img.rows - ch) / 2, cw, ch);
+    scale = std::min(scale, static_cast<double>(P.fovea_max_side) / std::max(cw, ch));
+    cv::Mat patch = img(crop);
+    if (std::abs(scale - 1) > 1e-3) {
+      cv::Mat resized;
+      cv::resize(patch, resized, cv::Size(), scale, scale,
+                 scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
+      patch = resized;
+    }
+    ++ob.timing.fovea_looks;
+
+    landmarks::FeatureParams fp = model.params().features;
+    fp.max_image_side = std::max({64, patch.cols, patch.rows});  // already at the chosen size
+    fp.max_features = P.fovea_max_features;
+    const auto feats = landmarks::computeFrameFeatures(model, patch, fp);
+    auto m = landmarks::match(model, feats, cv::Rect(), l.class_name, mp);
+    if (!m.matched) continue;
+
+    // Crop pixels -> full-frame pixels (per axis: resize rounds the scaled size).
+    const double sx = static_cast<double>(patch.cols) / cw,
+                 sy = static_cast<double>(patch.rows) / ch;
+    for (auto& p : m.x_t)
+      p = {static_cast<float>(crop.x + p.x / sx), static_cast<float>(crop.y + p.y / sy)};
+    if (!m.H.empty()) {
+      const cv::Mat A = (cv::Mat_<double>(3, 3) << 1 / sx, 0, crop.x, 0, 1 / sy, crop.y, 0, 0, 1);
+      m.H = A * m.H;
+    }
+    m.window = crop;
+    Detection d;
+    // The window drawn for it: the matched keypoints' extent, inside the crop.
+    const cv::Rect box = cv::boundingRect(m.x_t) & crop;
+    if (!toDetection(m, l.class_name, box.area() > 0 ? box : crop, img.cols, K, P, d)) continue;
+    ob.detections.push_back(d);
+  }
+  std::sort(ob.detections.begin(), ob.detections.end(),
+            [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
+  ob.timing.fovea_ms = msSince(tf);
   ob.timing.total_ms = msSince(t0);
   return ob;
 }

@@ -30,7 +30,17 @@ struct Detection {
 
 struct PerceptionTiming {
   double objectness_ms = 0, features_ms = 0, match_ms = 0, total_ms = 0;  // wall time
-  int windows = 0;  // objectness windows examined
+  double fovea_ms = 0;  // wall time of the foveal second looks (part of total_ms)
+  int windows = 0;      // objectness windows examined
+  int fovea_looks = 0;  // foveal crops examined (a hinted class missed by the normal pass)
+};
+
+/// A class to look for, with where the executive expects it (from the sketch). Without a
+/// finite bearing it is looked for like a bare class name.
+struct LookFor {
+  std::string class_name;
+  double bearing = NAN;  // [rad] robot frame, CCW positive, predicted
+  double range = NAN;    // [m] predicted (NaN: unknown, no upscaling)
 };
 
 struct Observation {
@@ -44,6 +54,11 @@ class Perception {
   /// Looks for `classes` in `frame`. Never throws for an unrecognisable frame (empty result).
   virtual Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
                               const std::vector<std::string>& classes) = 0;
+  /// Same, with where each class is expected. The default ignores the hints (looks for the
+  /// classes, in order, once each); LandmarkPerception takes a foveal second look at a hinted
+  /// class the normal pass missed. Detections are in full-frame coordinates either way.
+  virtual Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                              const std::vector<LookFor>& look_for);
 };
 
 struct PerceptionParams {
@@ -63,6 +78,29 @@ struct PerceptionParams {
   // so the default keeps the model's settings; raise both for small or distant landmarks.
   int frame_max_side = 400;      // [px] longer frame side above this is downscaled for SIFT
   int frame_max_features = 500;  // strongest keypoints kept per frame (0 = all)
+  // Foveal second look (observe() with LookFor hints only): for a hinted class the normal pass
+  // did not detect, whose predicted bearing is in the field of view, a crop of the
+  // full-resolution frame centred on the predicted column is matched on its own, upscaled by
+  // range / fovea_ref_range_m so a distant landmark has as many pixels as a near one. Same
+  // min_inliers rule: never a guess. Costs time only when a hinted landmark was missed. The
+  // crop is narrowish: less clutter competes with the landmark for the keypoint budget (lab,
+  // 2-6 m, head-on and 40 deg off: 0.3 / 0.4 / 0.5 of the frame wide found 26 / 22 / 20 of
+  // the 80 landmarks the normal pass missed), but 0.4 still finds as many with the hint 10 deg
+  // off (0.3: none). It is centred vertically, fovea_height of the frame tall, taller for a
+  // landmark nearer than 2 x fovea_ref_range_m (frame height / upscale), which may be seen
+  // well above or below the centre. doc/landmark-model.md "Foveal second look".
+  bool fovea = true;               // take the second look at all
+  double fovea_min_range_m = 0;    // [m] no second look at landmarks predicted nearer
+  double fovea_max_range_m = 6;    // [m] nor further (too few pixels even upscaled; lab: 1
+                                   //     of 16 found at 6 m)
+  double fovea_width = 0.4;        // crop width, fraction of the frame width, (0, 1]
+  double fovea_height = 0.5;       // least crop height, fraction of the frame height, (0, 1]
+  double fovea_ref_range_m = 2.0;  // [m] crop upscale = predicted range / this (at least 1)
+  double fovea_max_upscale = 3.0;  // upscale at most this, in [1, 8]
+  int fovea_max_side = 640;        // [px] the upscaled crop's longer side at most this
+  int fovea_max_features = 1000;   // strongest keypoints kept in the crop (0 = all)
+  int fovea_max_looks = 1;         // second looks per frame at most, in hint order (the
+                                   // executive lists the landmark it servos on first)
   template <class B>
   void bind(B& b) {
     b("max_windows", max_windows);
@@ -75,6 +113,16 @@ struct PerceptionParams {
     b("merge_iou", merge_iou);
     b("frame_max_side", frame_max_side);
     b("frame_max_features", frame_max_features);
+    b("fovea", fovea);
+    b("fovea_min_range_m", fovea_min_range_m);
+    b("fovea_max_range_m", fovea_max_range_m);
+    b("fovea_width", fovea_width);
+    b("fovea_height", fovea_height);
+    b("fovea_ref_range_m", fovea_ref_range_m);
+    b("fovea_max_upscale", fovea_max_upscale);
+    b("fovea_max_side", fovea_max_side);
+    b("fovea_max_features", fovea_max_features);
+    b("fovea_max_looks", fovea_max_looks);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
 };
@@ -88,6 +136,10 @@ class LandmarkPerception final : public Perception {
   ~LandmarkPerception() override;
   Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
                       const std::vector<std::string>& classes) override;
+  /// The normal pass for the hinted classes, then a foveal second look (PerceptionParams
+  /// fovea_*) at each hinted class it missed.
+  Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                      const std::vector<LookFor>& look_for) override;
 
  private:
   struct Impl;

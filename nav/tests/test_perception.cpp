@@ -1,0 +1,275 @@
+// LandmarkPerception's foveal second look: a landmark too small for the normal (downscaled)
+// pass is found in a full-resolution, upscaled crop around the column the hint predicts, with
+// its bearing in full-frame coordinates; never where the hint does not point, never with the
+// fovea off. Uses two demo-set classes (share/landmarks) and their catalogue photos.
+#include <gtest/gtest.h>
+
+#include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
+
+#include <cmath>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/error.h"
+#include "sketchnav/landmarks/model.h"
+#include "sketchnav/nav/perception.h"
+#include "test_data.h"
+
+namespace sketchnav::nav {
+namespace {
+
+const char* kTarget = "Alpro-Blueberry-Soyghurt";
+const char* kOther = "Oatly-Oat-Milk";
+
+std::string landmarkDir() {
+  return test::sourceDir() + "/share/landmarks";
+}
+
+std::string iconic(const std::string& cls) {
+  return landmarkDir() + "/" + cls + "/" + cls + "_Iconic.jpg";
+}
+
+// A room-like 640x480 frame: smooth random shading plus clutter (boxes, discs, digits), with
+// `photo` pasted `width` px wide centred at (u, v). Deterministic for a seed.
+cv::Mat sceneWith(const cv::Mat& photo, int width, double u, double v, unsigned seed) {
+  cv::RNG rng(seed);
+  cv::Mat img(480, 640, CV_8UC3);
+  rng.fill(img, cv::RNG::UNIFORM, 70, 190);
+  cv::GaussianBlur(img, img, cv::Size(0, 0), 6);
+  for (int i = 0; i < 40; ++i) {
+    const cv::Scalar c(rng.uniform(0, 255), rng.uniform(0, 255), rng.uniform(0, 255));
+    const cv::Point a(rng.uniform(0, 640), rng.uniform(0, 480));
+    if (i % 3 == 0)
+      cv::rectangle(img, a, a + cv::Point(rng.uniform(5, 90), rng.uniform(5, 70)), c, -1);
+    else if (i % 3 == 1)
+      cv::circle(img, a, rng.uniform(3, 30), c, -1);
+    else
+      cv::putText(img, std::to_string(rng.uniform(10, 9999)), a, cv::FONT_HERSHEY_SIMPLEX,
+                  rng.uniform(0.4, 1.2), c, 1);
+  }
+  cv::Mat small;
+  const double s = static_cast<double>(width) / photo.cols;
+  cv::resize(photo, small, cv::Size(), s, s, cv::INTER_AREA);
+  const cv::Rect at(static_cast<int>(std::lround(u - small.cols / 2.0)),
+                    static_cast<int>(std::lround(v - small.rows / 2.0)), small.cols, small.rows);
+  small.copyTo(img(at));
+  cv::Mat noise(img.size(), CV_16SC3);
+  rng.fill(noise, cv::RNG::NORMAL, 0, 2);
+  cv::Mat out;
+  img.convertTo(out, CV_16SC3);
+  out += noise;
+  out.convertTo(img, CV_8UC3);
+  return img;
+}
+
+class FoveaTest : public ::testing::Test {
+ protected:
+  static void SetUpTestSuite() {
+    // Two classes of the demo set (the others excluded: seconds, not a minute).
+    std::vector<std::string> exclude;
+    for (const auto& e : std::filesystem::directory_iterator(landmarkDir()))
+      if (e.is_directory() && e.path().filename() != kTarget && e.path().filename() != kOther)
+        exclude.push_back(e.path().filename().string());
+    landmarks::ModelParams p;
+    p.vocabulary_size = 100;
+    model_ = std::make_shared<const landmarks::LandmarkModel>(
+        landmarks::trainModel(landmarkDir(), p, {}, exclude));
+  }
+  static void TearDownTestSuite() { model_.reset(); }
+
+  static PerceptionParams params(bool fovea) {
+    PerceptionParams p;
+    p.whole_frame = true;  // the normal pass's best chance: windows and the whole frame
+    p.fovea = fovea;
+    return p;
+  }
+  // The bearing of image column u (what a detection there reports).
+  static double bearingOf(double u) { return -std::atan(K.normalisedX(u)); }
+
+  static inline const hw::Intrinsics K{};
+  static inline std::shared_ptr<const landmarks::LandmarkModel> model_;
+};
+
+int countClass(const Observation& ob, const std::string& cls, Detection* first = nullptr) {
+  int n = 0;
+  for (const auto& d : ob.detections)
+    if (d.class_name == cls) {
+      if (n == 0 && first) *first = d;
+      ++n;
+    }
+  return n;
+}
+
+TEST_F(FoveaTest, ModelHasBothClasses) {
+  ASSERT_EQ(model_->classes().size(), 2u);
+  EXPECT_GE(model_->classId(kTarget), 0);
+}
+
+// The landmark pasted 80 px wide (a 0.4 m carton ~2.8 m away at 554 px focal length: the
+// normal pass sees it 50 px wide and finds nothing), at the right edge (the crop is shifted to
+// stay inside the image) and on the left of the frame.
+TEST_F(FoveaTest, FindsASmallLandmarkWhereTheHintPointsWithItsFullFrameBearing) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  for (const double u : {600.0, 150.0}) {
+    SCOPED_TRACE("landmark at column " + std::to_string(u));
+    hw::Frame f;
+    f.image = sceneWith(photo, 80, u, 210, 11);
+    const double bearing = bearingOf(u);
+    const std::vector<LookFor> look = {{kTarget, bearing, 3.0}};  // upscaled x1.5
+
+    // Too small for the normal pass, with or without the hint.
+    LandmarkPerception plain(model_, params(false));
+    const Observation o0 = plain.observe(f, K, std::vector<std::string>{kTarget});
+    EXPECT_EQ(countClass(o0, kTarget), 0);
+    const Observation o1 = plain.observe(f, K, look);
+    EXPECT_EQ(countClass(o1, kTarget), 0);
+    EXPECT_EQ(o1.timing.fovea_looks, 0);
+
+    // The second look finds it, in full-frame coordinates.
+    LandmarkPerception foveal(model_, params(true));
+    const Observation ob = foveal.observe(f, K, look);
+    EXPECT_EQ(ob.timing.fovea_looks, 1);
+    EXPECT_GE(ob.timing.fovea_ms, 0);
+    EXPECT_GE(ob.timing.total_ms, ob.timing.fovea_ms);
+    Detection d;
+    ASSERT_EQ(countClass(ob, kTarget, &d), 1);
+    EXPECT_GE(d.inliers, params(true).min_inliers);
+    EXPECT_NEAR(d.bearing, bearing, 3.0 / K.fx);  // within 3 px
+    EXPECT_NEAR(d.x_t, K.normalisedX(u), 3.0 / K.fx);
+    EXPECT_NEAR(d.x_d, K.normalisedX(u) - (u - 320) / K.fx, 3.0 / K.fx);  // centred photo
+    EXPECT_TRUE((d.window & cv::Rect(0, 0, 640, 480)) == d.window);
+    EXPECT_TRUE(d.window.contains({static_cast<int>(u), 210}));
+    EXPECT_EQ(countClass(ob, kOther), 0);
+
+    // A hint for the other class at the same place finds nothing: never a guess.
+    const Observation other = foveal.observe(f, K, std::vector<LookFor>{{kOther, bearing, 3.0}});
+    EXPECT_EQ(other.timing.fovea_looks, 1);
+    EXPECT_TRUE(other.detections.empty());
+  }
+}
+
+TEST_F(FoveaTest, NotFoundWhereTheHintDoesNotPoint) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 80, 470, 210, 11);
+  LandmarkPerception foveal(model_, params(true));
+  // The crop around the other half of the image does not contain it.
+  const Observation ob = foveal.observe(f, K, std::vector<LookFor>{{kTarget, bearingOf(150), 3.0}});
+  EXPECT_EQ(ob.timing.fovea_looks, 1);
+  EXPECT_EQ(countClass(ob, kTarget), 0);
+  // Outside the field of view, behind the robot, or without a bearing: no second look.
+  for (const double b : {1.2, -1.2, M_PI, double(NAN)}) {
+    const Observation o = foveal.observe(f, K, std::vector<LookFor>{{kTarget, b, 3.0}});
+    EXPECT_EQ(o.timing.fovea_looks, 0) << b;
+    EXPECT_EQ(countClass(o, kTarget), 0) << b;
+  }
+  // Predicted beyond fovea_max_range_m: none either.
+  const Observation far = foveal.observe(f, K, std::vector<LookFor>{{kTarget, bearingOf(470), 9}});
+  EXPECT_EQ(far.timing.fovea_looks, 0);
+}
+
+TEST_F(FoveaTest, NoSecondLookWhenTheNormalPassFindsIt) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 180, 430, 230, 12);
+  LandmarkPerception foveal(model_, params(true));
+  const Observation plain = foveal.observe(f, K, std::vector<std::string>{kTarget});
+  Detection d0;
+  ASSERT_EQ(countClass(plain, kTarget, &d0), 1);
+  const Observation ob = foveal.observe(f, K, std::vector<LookFor>{{kTarget, bearingOf(430), 2}});
+  EXPECT_EQ(ob.timing.fovea_looks, 0);
+  Detection d;
+  ASSERT_EQ(countClass(ob, kTarget, &d), 1);
+  EXPECT_EQ(d.inliers, d0.inliers);
+  EXPECT_DOUBLE_EQ(d.bearing, d0.bearing);
+}
+
+// fovea_max_looks bounds the time per frame: hints are served in order.
+TEST_F(FoveaTest, AtMostMaxLooksInHintOrder) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 80, 470, 210, 11);
+  const std::vector<LookFor> look = {{kOther, bearingOf(470), 3.0}, {kTarget, bearingOf(470), 3.0}};
+  LandmarkPerception one(model_, params(true));
+  const Observation o1 = one.observe(f, K, look);
+  EXPECT_EQ(o1.timing.fovea_looks, 1);
+  EXPECT_TRUE(o1.detections.empty());
+  PerceptionParams p = params(true);
+  p.fovea_max_looks = 2;
+  LandmarkPerception two(model_, p);
+  const Observation o2 = two.observe(f, K, look);
+  EXPECT_EQ(o2.timing.fovea_looks, 2);
+  EXPECT_EQ(countClass(o2, kTarget), 1);
+  EXPECT_EQ(countClass(o2, kOther), 0);
+}
+
+// The camera pan moves the predicted column: a hint in the robot frame is found with a
+// panned camera, and the bearing includes the pan.
+TEST_F(FoveaTest, CameraYawShiftsThePredictedColumn) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 80, 470, 210, 11);
+  PerceptionParams p = params(true);
+  p.camera_yaw = 0.3;
+  LandmarkPerception foveal(model_, p);
+  const double bearing = 0.3 + bearingOf(470);
+  const Observation ob = foveal.observe(f, K, std::vector<LookFor>{{kTarget, bearing, 3.0}});
+  Detection d;
+  ASSERT_EQ(countClass(ob, kTarget, &d), 1);
+  EXPECT_NEAR(d.bearing, bearing, 3.0 / K.fx);
+  // Without the pan the same hint points 0.3 rad left of the landmark: nothing.
+  LandmarkPerception unpanned(model_, params(true));
+  EXPECT_EQ(
+      countClass(unpanned.observe(f, K, std::vector<LookFor>{{kTarget, bearing, 3.0}}), kTarget),
+      0);
+}
+
+// Perception implementations without a fovea get the hinted classes, each once, in order.
+TEST(PerceptionDefault, LookForForwardsToTheClassesOverload) {
+  struct Recorder final : Perception {
+    std::vector<std::string> got;
+    Observation observe(const hw::Frame&, const hw::Intrinsics&,
+                        const std::vector<std::string>& classes) override {
+      got = classes;
+      return {};
+    }
+    using Perception::observe;
+  } r;
+  Perception& p = r;
+  p.observe(hw::Frame{}, hw::Intrinsics{}, std::vector<LookFor>{{"a", 0.1, 2}, {"b"}, {"a"}});
+  EXPECT_EQ(r.got, (std::vector<std::string>{"a", "b"}));
+}
+
+TEST(PerceptionParamsTest, FoveaFieldsAreValidated) {
+  const auto bad = [](auto set, const std::string& field) {
+    PerceptionParams p;
+    set(p);
+    try {
+      p.validate();
+      ADD_FAILURE() << field << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find("nav.perception." + field), std::string::npos)
+          << e.what();
+    }
+  };
+  EXPECT_NO_THROW(PerceptionParams{}.validate());
+  bad([](PerceptionParams& p) { p.fovea_width = 0; }, "fovea_width");
+  bad([](PerceptionParams& p) { p.fovea_height = 1.5; }, "fovea_height");
+  bad([](PerceptionParams& p) { p.fovea_ref_range_m = 0; }, "fovea_ref_range_m");
+  bad([](PerceptionParams& p) { p.fovea_max_upscale = 0.5; }, "fovea_max_upscale");
+  bad([](PerceptionParams& p) { p.fovea_max_side = 10; }, "fovea_max_side");
+  bad([](PerceptionParams& p) { p.fovea_max_features = -1; }, "fovea_max_features");
+  bad([](PerceptionParams& p) { p.fovea_min_range_m = -1; }, "fovea_min_range_m");
+  bad([](PerceptionParams& p) { p.fovea_max_range_m = 0; }, "fovea_max_range_m");
+  bad([](PerceptionParams& p) { p.fovea_max_looks = -1; }, "fovea_max_looks");
+}
+
+}  // namespace
+}  // namespace sketchnav::nav
