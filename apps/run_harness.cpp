@@ -199,6 +199,12 @@ class TappedPerception final : public nav::Perception {
     if (tap_) tap_(frame, obs);
     return obs;
   }
+  nav::Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                           const std::vector<nav::LookFor>& look_for) override {
+    nav::Observation obs = inner_.observe(frame, k, look_for);
+    if (tap_) tap_(frame, obs);
+    return obs;
+  }
 
  private:
   nav::Perception& inner_;

@@ -100,6 +100,7 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
       tr.updates = 1;
       tr.free_hits = on_free;
       tr.born_free = on_free;
+      tr.history.push_back({t, centre});
       born.push_back(tr);
       continue;
     }
@@ -114,6 +115,28 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
     tr.t = t;
     ++tr.updates;
     tr.free_hits += on_free;
+    tr.history.push_back({t, centre});
+    while (!tr.history.empty() && t - tr.history.front().first > 1.2)
+      tr.history.erase(tr.history.begin());
+    // Straight-line fit over the last 1.2 s: a walking person's centre moves steadily; a
+    // track that jumped between two objects, or a visible part that grows and shrinks, does
+    // not fit a line.
+    const size_t m = tr.history.size();
+    tr.steady = false;
+    if (m >= 6 && tr.history.back().first - tr.history.front().first >= 0.5) {
+      double st = 0, stt = 0;
+      Eigen::Vector2d sp(0, 0), stp(0, 0);
+      for (const auto& [ti, pi] : tr.history) st += ti, stt += ti * ti, sp += pi, stp += ti * pi;
+      const double den = m * stt - st * st;
+      if (den > 1e-9) {
+        const Eigen::Vector2d v = (m * stp - st * sp) / den;
+        const Eigen::Vector2d p0 = (sp - v * st) / static_cast<double>(m);
+        double ss = 0;
+        for (const auto& [ti, pi] : tr.history) ss += (p0 + v * ti - pi).squaredNorm();
+        tr.fit_vel = v;
+        tr.steady = std::sqrt(ss / m) <= 0.06;
+      }
+    }
   }
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const Track& tr) { return t - tr.t > p_.forget_s; }),
@@ -123,13 +146,15 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
 
 std::vector<Mover> MoverTracker::movers() const {
   std::vector<Mover> out;
-  for (const auto& tr : tracks_)
-    // First seen on floor seen free, or often stepping onto it (a walking person keeps
-    // entering cells seen free; a wall or a table edge is where the grid saw something), at a
-    // walking pace (a cluster sliding along a wall as the beams sweep it is "fast").
-    if ((tr.born_free || 3 * tr.free_hits >= tr.updates) && tr.updates >= p_.min_updates &&
-        tr.vel.norm() >= p_.min_speed && tr.vel.norm() <= 2.5)
-      out.push_back({tr.pos, tr.vel, tr.updates});
+  for (const auto& tr : tracks_) {
+    // First seen on floor the grid had seen free (a wall or a table edge is where the grid
+    // saw something; a cluster that slides along one as the beams sweep it, or as a shadow
+    // moves over it, is not born there), mostly on free floor since, at a walking pace.
+    const double sp = tr.fit_vel.norm();
+    if (tr.steady && tr.born_free && 4 * tr.free_hits >= tr.updates &&
+        tr.updates >= p_.min_updates && sp >= p_.min_speed && sp <= 1.8)
+      out.push_back({tr.pos, tr.fit_vel, tr.updates});
+  }
   return out;
 }
 
@@ -160,6 +185,7 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
         err = std::atan2(std::sin(err + M_PI), std::cos(err + M_PI));
       }
       a.active = a.in_lane = true;
+      a.mover = m;
       a.w = k_heading * err;
       a.v = std::abs(err) < M_PI / 3 ? dir * v_max * std::cos(err) : 0.0;
       return a;
@@ -179,6 +205,7 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
       const Eigen::Vector2d B = m.position + m.velocity * p_.horizon_s;
       if (segDist({x, y}, A, B) < R) {
         a.active = true;
+        a.mover = m;
         a.v = 0;  // let it pass; turning on the spot is harmless
         a.w = w;
         return a;

@@ -18,11 +18,12 @@ namespace {
 // The robot at `robot` watches the empty room (the floor is seen free), then a person walks
 // from `from` with `vel` for `secs` at 10 Hz.
 MoverTracker watch(LocalPlanner& grid, const hw::Pose2D& robot, Eigen::Vector2d from,
-                   Eigen::Vector2d vel, double secs, std::vector<Box> extra = {}) {
+                   Eigen::Vector2d vel, double secs, bool enabled = true) {
   auto boxes = room();
-  boxes.insert(boxes.end(), extra.begin(), extra.end());
   for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
-  MoverTracker tr;
+  MoverParams on;
+  on.enabled = enabled;
+  MoverTracker tr(on);
   const LocalPlanner before = grid.snapshot();  // the grid before the person walked in
   for (double t = 0.5; t <= 0.5 + secs + 1e-9; t += 0.1) {
     const Eigen::Vector2d p = from + vel * (t - 0.5);
@@ -46,7 +47,9 @@ TEST(Movers, AWalkingPersonIsAMoverWithItsVelocity) {
 
 TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
   LocalPlanner grid;
-  MoverTracker tr;
+  MoverParams on;
+  on.enabled = true;
+  MoverTracker tr(on);
   auto boxes = room();
   boxes.push_back({3, 1.0, 0.25, 0.25});  // a person-sized box
   LocalPlanner before = grid.snapshot();
@@ -84,12 +87,14 @@ TEST(Movers, TheRobotDoesNotDriveIntoALane) {
   EXPECT_FALSE(tr.advise({0, 0, M_PI}, 0.3, 0.0, 1.5, 0.3).active);
 }
 
-TEST(Movers, OffMeansNoAdvice) {
-  MoverParams p;
-  p.enabled = false;
-  MoverTracker tr(p);
+TEST(Movers, OffByDefaultAndThenNoAdvice) {
+  EXPECT_FALSE(MoverParams{}.enabled);
+  LocalPlanner grid;
+  // The same crossing that stops the robot when the tracker is on.
+  const auto tr = watch(grid, {0, 0, 0}, {0.8, 2.5}, {0.0, -0.4}, 1.0, /*enabled=*/false);
+  EXPECT_TRUE(tr.movers().empty());
   EXPECT_FALSE(tr.advise({0, 0, 0}, 0.3, 0.0, 1.5, 0.3).active);
-  p.enabled = true;
+  MoverParams p;
   p.min_updates = 1;
   EXPECT_THROW(MoverTracker{p}, InputError);
 }

@@ -108,6 +108,7 @@ struct ExecutiveParams {
   // stop 0.5-0.8 m short. 0 = off.
   double final_look_range_m = 4.0;  // [m]
   double final_look_s = 5.0;        // [s]
+  bool final_look_fovea = true;     // hand the expected bearing to perception (foveal look)
   bool detour = true;
   double detour_ahead_m = 3.0;  // [m]
   double replan_s = 0.5;        // [s]
@@ -156,6 +157,7 @@ struct ExecutiveParams {
     b("same_class_gate_m", same_class_gate_m);
     b("final_look_range_m", final_look_range_m);
     b("final_look_s", final_look_s);
+    b("final_look_fovea", final_look_fovea);
     b("detour", detour);
     b("detour_ahead_m", detour_ahead_m);
     b("replan_s", replan_s);
