@@ -385,7 +385,9 @@ struct Executive::Impl {
       }
       if (hold && tracker.progress(pose).remaining_m < -s.exec.miss_slack_m) hold = false;
     }
-    final_looking = false;
+    // A final look under way continues whichever way it started (at the goal, or settled near
+    // it): it holds the route open and turns the robot.
+    final_looking = fl_k >= 0 && !fl_done && finalLook();
     // At the goal: a landmark of the last section that was seen moves the goal when it is
     // passed (re-fit), so pass it first and judge arrival against the corrected goal.
     if (!hold && !tracker.finished() && tracker.current() + 1 == tracker.count() &&
@@ -397,9 +399,9 @@ struct Executive::Impl {
           passLandmark(kl, static_cast<int>(i), false);
       }
       if (status != RunStatus::Running) return;
-      final_looking = finalLook();
-      hold |= final_looking;
+      if (!final_looking) final_looking = finalLook();
     }
+    hold |= final_looking;
     if (!hold && tracker.update(pose) > 0) closeSections(before);
     if (status != RunStatus::Running) return;
     if (tracker.finished()) {
