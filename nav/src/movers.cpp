@@ -165,7 +165,8 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
   const double R = p_.person_radius_m + p_.robot_radius_m + p_.margin_m;
   const Eigen::Vector2d P(robot.x, robot.y);
   a.clearance_m = 1e9;
-  for (const auto& m : movers()) {
+  const std::vector<Mover> ms = movers();
+  for (const auto& m : ms) {
     if ((m.position - P).norm() > p_.range_m) continue;
     a.clearance_m =
         std::min(a.clearance_m, (m.position - P).norm() - p_.person_radius_m - p_.robot_radius_m);
@@ -193,7 +194,7 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
   }
   // Not in a lane: would the command take the robot into one within look_ahead_s?
   if (v <= 0) return a;
-  for (const auto& m : movers()) {
+  for (const auto& m : ms) {
     if ((m.position - P).norm() > p_.range_m) continue;
     double x = robot.x, y = robot.y, th = robot.theta;
     for (double t = 0.1; t <= p_.look_ahead_s + 1e-9; t += 0.1) {
