@@ -211,6 +211,9 @@ struct Executive::Impl {
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
   std::vector<std::string> fixes_class;                  // class of each ("" for the start)
   std::vector<Eigen::Matrix2d> fixes_info;               // how well each was seen [1/m^2]
+  // Across-ray unit normal of a bearing-only fix (placed only across its rays; its point
+  // along them means nothing), zero for the others.
+  std::vector<Eigen::Vector2d> fixes_across;
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -536,10 +539,13 @@ struct Executive::Impl {
         t.last_seen = now;
         t.last_range = range;
         t.last_bearing = d.bearing;
-        // Far ranges may be something else along the bearing; an unranged bearing still helps.
-        if (range <= fixRange()) {
+        // Far ranges may be something else along the bearing; the bearing still helps.
+        {
           if (t.sightings.size() >= 80) t.sightings.erase(t.sightings.begin());
-          t.sightings.push_back({{pose.x, pose.y}, pose.theta + d.bearing, range});
+          const bool far = range > fixRange();
+          if (!far || s.exec.fit_bearing_only)
+            t.sightings.push_back(
+                {{pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0});
         }
         if (n == 0) {
           const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
@@ -940,7 +946,7 @@ struct Executive::Impl {
     const Eigen::Vector2d o(pose.x, pose.y);
     const Eigen::Vector2d dir(std::cos(pose.theta + d.bearing), std::sin(pose.theta + d.bearing));
     for (size_t j = 1; j < fixes_odom.size(); ++j) {
-      if (fixes_class[j] != cls) continue;
+      if (fixes_class[j] != cls || !fixes_across[j].isZero()) continue;
       const Eigen::Vector2d v = fixes_odom[j] - o;
       if (range > 0 && range <= fixRange()) {
         if ((o + range * dir - fixes_odom[j]).norm() < s.exec.same_class_gate_m) return true;
@@ -996,16 +1002,28 @@ struct Executive::Impl {
     // its gain. A landmark that slid out of view when close was seen as well as one passed in
     // view, and the last landmark before the goal is often passed that way.
     LandmarkFix lf = locateLandmark(tr.sightings, s.locate);
-    // Located where an earlier landmark of the same class was: the sightings were of that one.
-    for (size_t j = 1; lf.ok && j < fixes_odom.size(); ++j)
-      if (fixes_class[j] == lm.class_name &&
-          (fixes_odom[j] - lf.position).norm() < s.exec.same_class_gate_m) {
+    if (lf.ok && lf.bearing_only && !(s.exec.fit_bearing_only && s.exec.fit_weighted))
+      lf.ok = false;  // (an equal-weight fit would take its nominal point as exact)
+    // Across the rays of a bearing-only fix (the newest sighting's).
+    Eigen::Vector2d across = Eigen::Vector2d::Zero();
+    if (lf.ok && lf.bearing_only) {
+      const double a = tr.sightings.back().direction;
+      across = {-std::sin(a), std::cos(a)};
+    }
+    // Located where an earlier landmark of the same class was (a bearing-only one: its rays
+    // pass there): the sightings were of that one.
+    for (size_t j = 1; lf.ok && j < fixes_odom.size(); ++j) {
+      if (fixes_class[j] != lm.class_name || !fixes_across[j].isZero()) continue;
+      const Eigen::Vector2d v = fixes_odom[j] - lf.position;
+      if (lf.bearing_only ? std::abs(across.dot(v)) < 0.5 * s.exec.same_class_gate_m
+                          : v.norm() < s.exec.same_class_gate_m) {
         lf.ok = false;
         e["fix_rejected"] = "where an earlier " + lm.class_name + " was";
       }
+    }
     if (lf.ok) {
       const Eigen::Vector2d seen = lf.position;
-      e["fix_method"] = lf.triangulated ? "bearings" : "ranges";
+      e["fix_method"] = lf.bearing_only ? "bearing only" : lf.triangulated ? "bearings" : "ranges";
       e["fix_rays"] = lf.rays;
       e["fix_ranges_used"] = lf.ranges_used;
       e["fix_ranges_dropped"] = lf.ranges_dropped;
@@ -1015,11 +1033,16 @@ struct Executive::Impl {
             {std::round(q.origin.x() * 1000) / 1000, std::round(q.origin.y() * 1000) / 1000,
              std::round(q.direction * 10000) / 10000, std::round(q.range_m * 1000) / 1000});
       e["sightings"] = rays;
-      const Eigen::Vector2d shift = seen - tracker.toOdom(lm.position_m);
+      // A bearing-only fix says nothing along its rays: only the across part shifts anything.
+      auto toward = [&](const Eigen::Vector2d& d) -> Eigen::Vector2d {
+        return lf.bearing_only ? Eigen::Vector2d(across * across.dot(d)) : d;
+      };
+      const Eigen::Vector2d shift = toward(seen - tracker.toOdom(lm.position_m));
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
       fixes_info.push_back(lf.information);
       fixes_class.push_back(lm.class_name);
+      fixes_across.push_back(across);
       // With enough fixes spread far enough: refit rotation, scale and translation to the
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
       // part of the way to this one (hand-drawn maps are also locally distorted).
@@ -1046,16 +1069,24 @@ struct Executive::Impl {
         }
         // Not towards the newest fix when the fit found it an outlier.
         if (f.used.empty() || f.used.back())
-          tracker.reanchor(lm.position_m, seen, s.exec.fit_local_gain);
+          tracker.reanchor(
+              lm.position_m,
+              tracker.toOdom(lm.position_m) + toward(seen - tracker.toOdom(lm.position_m)),
+              s.exec.fit_local_gain);
         e["fit_rotation_deg"] = f.rotation * 180 / M_PI;
         e["fit_scale"] = tracker.scale();
         e["fit_rms_m"] = f.rms;
         e["fit_fixes"] = idx.size();
         e["fit_dropped"] = f.dropped;
       } else {
-        const double rot = tracker.realign(lm.position_m, seen, fix_route, fix_odom,
-                                           s.exec.realign_gain, s.exec.realign_baseline_m);
-        tracker.reanchor(lm.position_m, seen, s.exec.reanchor_gain);
+        const double rot = lf.bearing_only
+                               ? 0.0
+                               : tracker.realign(lm.position_m, seen, fix_route, fix_odom,
+                                                 s.exec.realign_gain, s.exec.realign_baseline_m);
+        tracker.reanchor(
+            lm.position_m,
+            tracker.toOdom(lm.position_m) + toward(seen - tracker.toOdom(lm.position_m)),
+            s.exec.reanchor_gain);
         e["realign_deg"] = rot * 180 / M_PI;
         e["reanchor_m"] = shift.norm() * s.exec.reanchor_gain;
       }
@@ -1063,8 +1094,10 @@ struct Executive::Impl {
       // Both ends of the fix, for judging the sketch's and the estimator's errors offline.
       e["fix_route"] = {lm.position_m.x(), lm.position_m.y()};
       e["fix_odom"] = {seen.x(), seen.y()};
-      fix_route = lm.position_m;
-      fix_odom = seen;
+      if (!lf.bearing_only) {  // the anchor of the next realign: a point, not a ray
+        fix_route = lm.position_m;
+        fix_odom = seen;
+      }
     }
     event(e);
     log::info("nav", "landmark passed", {{"id", lm.id}, {"class", lm.class_name}});
@@ -1114,6 +1147,7 @@ void Executive::start() {
   I.fixes_odom = {I.fix_odom};
   I.fixes_class = {""};
   I.fixes_info = {Eigen::Matrix2d::Identity() / (0.05 * 0.05)};  // the start: where it is put
+  I.fixes_across = {Eigen::Vector2d::Zero()};
   I.safety.start(I.t0);
   I.status = RunStatus::Running;
   I.event({{"type", "start"},

@@ -60,6 +60,10 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
   if (ss.empty()) return f;
   const double sb = p.bearing_sigma_deg * M_PI / 180;
   auto unit = [](double a) { return Eigen::Vector2d(std::cos(a), std::sin(a)); };
+  // Distance of a sighting for its bearing's weight: the range, the reading beyond, or 3 m.
+  auto distanceOf = [](const Sighting& s) {
+    return s.range_m > 0 ? s.range_m : s.beyond_m > 0 ? s.beyond_m : 3.0;
+  };
   // Bearings: each pins the point across its ray to (distance x bearing error), the distance
   // from a first pass. A tiny prior at the rays' nominal points keeps the system solvable
   // when they are all parallel.
@@ -67,7 +71,7 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
   Eigen::Vector2d b, nominal(0, 0), mean_dir(0, 0);
   for (const auto& s : ss) {
     const Eigen::Vector2d u = unit(s.direction);
-    nominal += s.origin + (s.range_m > 0 ? s.range_m : 3.0) * u;
+    nominal += s.origin + distanceOf(s) * u;
     mean_dir += u;
   }
   nominal /= ss.size();
@@ -77,8 +81,7 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
     b = 1e-6 * nominal;
     for (const auto& s : ss) {
       const Eigen::Vector2d u = unit(s.direction), nn(-u.y(), u.x());
-      const double d =
-          std::max(0.5, pass == 0 && s.range_m > 0 ? s.range_m : (x - s.origin).norm());
+      const double d = std::max(0.5, pass == 0 ? distanceOf(s) : (x - s.origin).norm());
       const double w = 1.0 / (d * d * sb * sb);
       I += w * nn * nn.transpose(), b += w * nn.dot(s.origin) * nn;
     }
@@ -86,6 +89,20 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
   }
   const Eigen::Vector2d crossing = x;
   const Eigen::Matrix2d Cb = I.inverse();
+  // A landmark seen from one place, without a range (a far one: the laser along its bearing
+  // hits whatever is beyond), is still on its rays: across them it is known to range x
+  // bearing error, which is what the refit needs to turn the route.
+  const Eigen::Matrix2d I_rays = I;
+  auto bearingOnly = [&] {
+    LandmarkFix o;
+    o.ok = true;
+    o.bearing_only = true;
+    o.rays = static_cast<int>(ss.size());
+    o.ranges_dropped = f.ranges_dropped;
+    o.position = crossing;
+    o.information = I_rays;
+    return o;
+  };
   mean_dir.normalize();
   double lo = 0, hi = 0;  // spread of the rays' directions
   for (const auto& s : ss) {
@@ -103,7 +120,7 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
         const Eigen::Vector2d q = s.origin + s.range_m * unit(s.direction);
         xs.push_back(q.x()), ys.push_back(q.y());
       }
-    if (xs.empty()) return f;  // neither crossing bearings nor a range
+    if (xs.empty()) return bearingOnly();  // neither crossing bearings nor a range
     std::nth_element(xs.begin(), xs.begin() + xs.size() / 2, xs.end());
     std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
     ref = {xs[xs.size() / 2], ys[ys.size() / 2]};
@@ -126,7 +143,7 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
     const double wr = 1.0 / (agree.size() * p.range_sigma_m * p.range_sigma_m);
     I += wr * u * u.transpose(), b += wr * (u.dot(s->origin) + s->range_m) * u;
   }
-  if (!f.triangulated && f.ranges_used == 0) return f;
+  if (!f.triangulated && f.ranges_used == 0) return bearingOnly();
   f.ok = true;
   f.rays = static_cast<int>(ss.size());
   f.position = I.ldlt().solve(b);

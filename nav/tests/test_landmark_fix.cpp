@@ -74,10 +74,23 @@ TEST(LocateLandmark, TooLittleSpreadLeavesItToTheRanges) {
   EXPECT_NEAR(f.position.y(), 0.0, 1e-6);
 }
 
-TEST(LocateLandmark, NoRangeAndNoCrossingIsNoFix) {
+TEST(LocateLandmark, NoRangeAndNoCrossingIsABearingOnlyFix) {
   auto ss = driveBy({6.0, 0.0}, 0.0, 2.0, 5, 0.0, 0.0);
   for (auto& s : ss) s.range_m = 0;
-  EXPECT_FALSE(locateLandmark(ss, LocateParams{}).ok);
+  const LandmarkFix b = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(b.ok);
+  EXPECT_TRUE(b.bearing_only);
+  EXPECT_FALSE(b.triangulated);
+  EXPECT_EQ(b.rays, 5);
+  EXPECT_NEAR(b.position.y(), 0.0, 1e-6);  // on the rays
+  // Across the rays (y) as well as five bearings at ~3 m allow; along them (x) nothing.
+  EXPECT_GT(b.information(1, 1), 100.0);
+  EXPECT_LT(b.information(0, 0), 1e-3);
+  // Read as far away (the laser beyond), the same bearings are worth less across.
+  for (auto& s : ss) s.beyond_m = 7.0;
+  const LandmarkFix far = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(far.ok && far.bearing_only);
+  EXPECT_LT(far.information(1, 1), 0.5 * b.information(1, 1));
   EXPECT_FALSE(locateLandmark({}, LocateParams{}).ok);
   // Unranged bearings that do cross are enough.
   auto crossing = driveBy({5.0, -2.0}, 0.0, 4.0, 9, 0.3, 0.0);

@@ -241,6 +241,49 @@ TEST(SectionTracker, FitSimilarityWeightedIgnoresRangesThatHitTheFurnitureBehind
   EXPECT_NEAR(t.scale(), 1.06, 0.02);
 }
 
+TEST(SectionTracker, FitSimilarityWeightedTurnsTheRouteOnABearingOnlyFix) {
+  // The sketch is turned 0.1 rad and scaled 1.05 against the odometry frame. Three landmarks
+  // are ranged and located well, but near the start (span 6 m); the last one (the goal end)
+  // is only seen from 4 m away without a range (locateLandmark: bearing_only). Its rays still
+  // say which way the far end of the route lies.
+  const Fixes f = seenThrough(1.05, 0.1, {0, 0});
+  std::vector<WeightedFix> near, with_far;
+  for (size_t i = 0; i < f.route.size(); ++i) {
+    WeightedFix x{f.route[i], f.odom[i], Eigen::Matrix2d::Identity() / (0.05 * 0.05), i == 0};
+    // The user drew the near two 0.3 m off to the same side: that turns the near fit.
+    if (i == 1) x.odom_pt.y() += 0.3;
+    if (i == 2) x.odom_pt.y() += 0.3;
+    if (i + 1 < f.route.size() && (f.route[i] - f.route[0]).norm() < 7) near.push_back(x);
+  }
+  ASSERT_GE(near.size(), 3u);
+  with_far = near;
+  const Eigen::Vector2d far = f.odom.back();
+  std::vector<Sighting> rays;
+  for (int k = 0; k < 4; ++k) {
+    const Eigen::Vector2d o = far + Eigen::Vector2d(-4.0 + 0.2 * k, -0.5);
+    rays.push_back({o, std::atan2((far - o).y(), (far - o).x()), 0.0, 0.0});
+  }
+  const LandmarkFix lf = locateLandmark(rays, LocateParams{});
+  ASSERT_TRUE(lf.ok && lf.bearing_only);
+  with_far.push_back({f.route.back(), lf.position, lf.information, false});
+  SectionTracker a(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  SectionTracker b(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  ASSERT_TRUE(a.fitSimilarityWeighted(near, WeightedFitParams{}).ok);
+  const auto fb = b.fitSimilarityWeighted(with_far, WeightedFitParams{});
+  ASSERT_TRUE(fb.ok);
+  EXPECT_EQ(fb.dropped, 0);
+  // The far end, across the bearing-only rays: 0.76 m off without the fix; with it, within
+  // the sketch error the fix itself carries (0.3 m).
+  const Eigen::Vector2d goal(14, -4);
+  const Eigen::Vector2d u = (far - rays.back().origin).normalized(), n(-u.y(), u.x());
+  const double without = std::abs(n.dot(a.toOdom(goal) - far));
+  const double with = std::abs(n.dot(b.toOdom(goal) - far));
+  EXPECT_GT(without, 0.6);
+  EXPECT_LT(with, 0.2);
+  // Along the rays the fix says nothing: the scale stays what the near fixes make it.
+  EXPECT_NEAR(b.scale(), a.scale(), 0.05);
+}
+
 TEST(SectionTracker, FitSimilarityWeightedTrustsBearingsWhereOnlyRangesPlaceALandmarkAlong) {
   // Headed straight at each landmark, from a different direction each time: only the (0.4 m
   // too long) ranges place a landmark along its rays. Weighted, the fit leans on each across

@@ -64,10 +64,13 @@ struct ExecutiveParams {
   // "stopped short of the goal": about 10 of 52 trials without it, 3 of 52 with it).
   bool fit_keep_start = true;
   double fit_outlier_m = 0.6;  // [m] a fix this far off the others' fit is left out
-  bool fit_weighted = true;    // each fix weighted by how well it was located (across / along
-                               // its rays, SectionTracker::fitSimilarityWeighted); false: equal
-                               // weights (fitSimilarity)
-  double realign_gain = 0.8;   // how much it re-rotates the route about the previous fix
+  // A landmark seen only from afar or from one place without a usable range still counts:
+  // its rays place it across them (locateLandmark: bearing_only), which turns the route.
+  bool fit_bearing_only = true;
+  bool fit_weighted = true;   // each fix weighted by how well it was located (across / along
+                              // its rays, SectionTracker::fitSimilarityWeighted); false: equal
+                              // weights (fitSimilarity)
+  double realign_gain = 0.8;  // how much it re-rotates the route about the previous fix
   double realign_baseline_m = 5.0;   // [m] minimum fix-to-landmark distance for that: a
                                      // sighting is good to ~0.3 m, so a shorter baseline
                                      // turns the route by more than it corrects
@@ -137,6 +140,7 @@ struct ExecutiveParams {
     b("fit_outlier_m", fit_outlier_m);
     b("fit_keep_start", fit_keep_start);
     b("fit_weighted", fit_weighted);
+    b("fit_bearing_only", fit_bearing_only);
     b("realign_gain", realign_gain);
     b("realign_baseline_m", realign_baseline_m);
     b("perception_period_s", perception_period_s);

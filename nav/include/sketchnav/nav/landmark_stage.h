@@ -76,12 +76,17 @@ struct LandmarkFix {
   Eigen::Vector2d position{0, 0};                         // [m] odometry frame
   Eigen::Matrix2d information = Eigen::Matrix2d::Zero();  // [1/m^2] inverse covariance
   bool triangulated = false;  // the bearings cross well (see LocateParams)
-  int rays = 0;               // sightings used
+  // Neither crossing bearings nor a range that agrees: the landmark is somewhere along its
+  // rays. `information` is then (nearly) rank one, across the view only, and `position` a
+  // nominal point on the rays (its place along them means nothing): the refit can still use
+  // it, but nothing may shift the route towards that point.
+  bool bearing_only = false;
+  int rays = 0;  // sightings used
   int ranges_used = 0, ranges_dropped = 0;
 };
 
 /// The landmark's position from its sightings (see LocateParams). Not ok when there is no
-/// sighting, or no range and the bearings do not cross well enough.
+/// sighting. With no range and bearings that do not cross well enough, ok and bearing_only.
 LandmarkFix locateLandmark(const std::vector<Sighting>& sightings, const LocateParams& p);
 
 }  // namespace sketchnav::nav

@@ -41,7 +41,11 @@ struct SectionParams {
 struct Sighting {
   Eigen::Vector2d origin{0, 0};  // [m] robot position
   double direction = 0;          // [rad] odometry-frame bearing of the landmark
-  double range_m = 0;            // [m]
+  double range_m = 0;            // [m] (<= 0: unranged)
+  // Unranged because the laser along the bearing read further than a landmark range is
+  // trusted (it may hit what stands beyond): that reading [m], as the sighting's distance
+  // for the weight of its bearing (the landmark is no further). 0: unknown.
+  double beyond_m = 0;
 };
 
 /// One fix for SectionTracker::fitSimilarityWeighted(): where the sketch puts a point (route
