@@ -38,6 +38,7 @@ void AvoidParams::validate() const {
           "must be in [0, 90)");
   require(moving_side_bias_deg >= 0 && moving_side_bias_deg < 90, "nav.avoid.moving_side_bias_deg",
           "must be in [0, 90)");
+  require(moving_away_m >= 0, "nav.avoid.moving_away_m", "must be >= 0 m");
   require(same_side_s >= 0, "nav.avoid.same_side_s", "must be >= 0");
   require(min_active_s >= 0, "nav.avoid.min_active_s", "must be >= 0");
   require(k_heading > 0, "nav.avoid.k_heading", "must be > 0");
@@ -210,6 +211,15 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
     // pedestrian (or round the far side of the same obstacle) is how near-misses happen.
     if (last_side_ != DodgeSide::None && now - last_end_t_ <= P.same_side_s) side_ = last_side_;
     if (side_ == DodgeSide::None) side_ = left >= right ? DodgeSide::Left : DodgeSide::Right;
+    // Someone coming towards the robot off to one side of its heading: step away from them,
+    // whichever side the landmark is on (dodging towards it, into their lane, is how the
+    // experiments' pedestrian walked into the robot).
+    if (moving > 0 && have_prev_pt_ && P.moving_away_m > 0) {
+      const Eigen::Vector2d d = prev_pt_ - Eigen::Vector2d(pose_.x, pose_.y);
+      const double lateral = -std::sin(pose_.theta) * d.x() + std::cos(pose_.theta) * d.y();
+      if (std::abs(lateral) >= P.moving_away_m)
+        side_ = lateral < 0 ? DodgeSide::Left : DodgeSide::Right;
+    }
     // The landmark's side is preferred unless it is closed while the other is open.
     const double mine = side_ == DodgeSide::Left ? left : right;
     const double other = side_ == DodgeSide::Left ? right : left;

@@ -79,6 +79,28 @@ TEST(Avoider, DodgesTowardsTheLandmarkSide) {
   }
 }
 
+TEST(Avoider, StepsAwayFromSomeoneComingTowardsItOffToOneSide) {
+  // A person 0.45 m right of the robot's heading walks at it at 0.5 m/s while the robot
+  // stands; the landmark is on the right. The same thing standing still: the landmark's side.
+  for (const bool walking : {true, false}) {
+    ObstacleAvoider a;
+    a.setPose({0, 0, 0});
+    AvoidOutput out;
+    for (int k = 0; k < 30 && !out.active; ++k) {
+      auto scan = laser({{walking ? 3.0 - 0.05 * k : 1.2, -0.45, 0.25}});
+      scan.stamp = 0.1 * k;
+      out = a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.0, 0.1 * k);
+    }
+    ASSERT_TRUE(out.active) << walking;
+    if (walking) {
+      EXPECT_GT(out.approach_speed, 0.25);
+      EXPECT_EQ(out.side, DodgeSide::Left);
+    } else {
+      EXPECT_EQ(out.side, DodgeSide::Right);
+    }
+  }
+}
+
 TEST(Avoider, TakesTheOtherSideWhenTheLandmarkSideIsClosed) {
   // Obstacle ahead, a wall 0.45 m to the left: dodging left is impossible.
   ObstacleAvoider a;

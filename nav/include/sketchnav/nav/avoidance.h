@@ -34,6 +34,9 @@ struct AvoidParams {
   double moving_side_bias_deg = 65;  // [deg] the same for an obstacle coming towards the robot:
                                      // a pedestrian closes at ~0.7 m/s, so step out of its
                                      // lane rather than edge round it
+  double moving_away_m = 0.15;       // [m] an obstacle coming towards the robot this far or
+                                     // more to one side of its heading: dodge to the other
+                                     // side, not the landmark's (0 = always the landmark's)
   double min_active_s = 1.0;         // [s] hold a manoeuvre at least this long (no chattering)
   double same_side_s = 3.0;          // [s] a manoeuvre starting this soon after the last one
                                      // ended dodges to the same side
@@ -53,6 +56,7 @@ struct AvoidParams {
     b("max_range_m", max_range_m);
     b("side_bias_deg", side_bias_deg);
     b("moving_side_bias_deg", moving_side_bias_deg);
+    b("moving_away_m", moving_away_m);
     b("min_active_s", min_active_s);
     b("same_side_s", same_side_s);
     b("k_heading", k_heading);
