@@ -214,9 +214,17 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
     // Someone coming towards the robot off to one side of its heading: step away from them,
     // whichever side the landmark is on (dodging towards it, into their lane, is how the
     // experiments' pedestrian walked into the robot).
+    // Judged by the middle of the returns around the point followed (that point is the edge
+    // nearest the robot's path, not where the person is).
     if (moving > 0 && have_prev_pt_ && P.moving_away_m > 0) {
       const Eigen::Vector2d d = prev_pt_ - Eigen::Vector2d(pose_.x, pose_.y);
-      const double lateral = -std::sin(pose_.theta) * d.x() + std::cos(pose_.theta) * d.y();
+      const Eigen::Vector2d q(std::cos(pose_.theta) * d.x() + std::sin(pose_.theta) * d.y(),
+                              -std::sin(pose_.theta) * d.x() + std::cos(pose_.theta) * d.y());
+      double sum = 0;
+      int n = 0;
+      for (const auto& [x, y] : pts)
+        if (std::hypot(x - q.x(), y - q.y()) < 0.45) sum += y, ++n;
+      const double lateral = n > 0 ? sum / n : q.y();
       if (std::abs(lateral) >= P.moving_away_m)
         side_ = lateral < 0 ? DodgeSide::Left : DodgeSide::Right;
     }

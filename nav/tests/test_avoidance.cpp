@@ -80,14 +80,14 @@ TEST(Avoider, DodgesTowardsTheLandmarkSide) {
 }
 
 TEST(Avoider, StepsAwayFromSomeoneComingTowardsItOffToOneSide) {
-  // A person 0.45 m right of the robot's heading walks at it at 0.5 m/s while the robot
+  // A person 0.3 m right of the robot's heading walks at it at 0.5 m/s while the robot
   // stands; the landmark is on the right. The same thing standing still: the landmark's side.
   for (const bool walking : {true, false}) {
     ObstacleAvoider a;
     a.setPose({0, 0, 0});
     AvoidOutput out;
     for (int k = 0; k < 30 && !out.active; ++k) {
-      auto scan = laser({{walking ? 3.0 - 0.05 * k : 1.2, -0.45, 0.25}});
+      auto scan = laser({{walking ? 3.0 - 0.05 * k : 1.2, -0.3, 0.25}});
       scan.stamp = 0.1 * k;
       out = a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.0, 0.1 * k);
     }
