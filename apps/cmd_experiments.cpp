@@ -125,7 +125,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       s.out_dir = vdir + "/trial-" + std::to_string(k + 1);
       fs::create_directories(s.out_dir);
       s.sketch_file = s.out_dir + "/sketch.json";
-      writeVariantSketch(v, noise, s.seed, vi, s.sketch_file);
+      writeVariantSketch(v, noise, s.seed, s.sketch_file);
       s.model = model;
       s.config_file = config_file;
       s.max_time_s = max_time;

@@ -232,7 +232,7 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
     for (int k = 0; k < seeds; ++k) {
       const int seed = seed0 + k;
       const std::string sk = sdir + "/sketch-" + std::to_string(seed) + ".json";
-      writeVariantSketch(v, noise, seed, si, sk);
+      writeVariantSketch(v, noise, seed, sk);
       for (size_t vi = 0; vi < values.size(); ++vi) {
         ScenarioSpec s;
         std::ostringstream val;

@@ -274,7 +274,9 @@ std::string writeVariantWorld(const Variant& v, const std::string& dir) {
 }
 
 void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
-                        std::size_t variant_index, const std::string& path) {
+                        const std::string& path) {
+  const auto it = std::find(kNames.begin(), kNames.end(), v.name);
+  const std::uint64_t variant_index = static_cast<std::uint64_t>(it - kNames.begin());
   const std::uint64_t noise_seed = static_cast<std::uint64_t>(seed) * 101 + variant_index;
   std::ofstream(path) << makeSketch(v, noise, noise_seed).dump(1) << "\n";
 }

@@ -58,10 +58,11 @@ SketchNoise sketchNoiseFrom(const Config& config);
 /// Writes the variant's world to <dir>/<name>.world.json (dir created); returns the path.
 std::string writeVariantWorld(const Variant& v, const std::string& dir);
 
-/// Writes a sketch of `v` for simulator seed `seed` to `path`. `variant_index` is mixed into the
-/// noise seed so variants in one batch do not share drawing errors.
+/// Writes a sketch of `v` for simulator seed `seed` to `path`. The variant's place in
+/// variantNames() is mixed into the noise seed, so variants do not share drawing errors and a
+/// trial's sketch is the same whichever variants are run with it (--variants a,b).
 void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
-                        std::size_t variant_index, const std::string& path);
+                        const std::string& path);
 
 /// Writes the run's --config/--set settings to <out>/config.json for the child runs; returns
 /// its path, or "" when there are none.

@@ -3,7 +3,9 @@
 // sketch noise is seeded.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
+#include <fstream>
 #include <map>
 #include <set>
 
@@ -78,6 +80,25 @@ TEST(ExperimentVariants, TransformationsAsDocumented) {
             makeVariant("exp3-8").world["obstacles"].size() + 1);
   EXPECT_NE(makeVariant("exp2-redrawn-c").drawn_path.size(),
             makeVariant("exp3-8").drawn_path.size());
+}
+
+TEST(ExperimentVariants, ATrialsSketchDependsOnItsVariantAndSeedOnly) {
+  // The variant's place in the full list is mixed in, not its place among the variants run:
+  // `--variants exp3-4` alone draws the same sketches as the full batch does for exp3-4.
+  const auto& names = variantNames();
+  const std::string dir = ::testing::TempDir();
+  auto written = [&](const std::string& name, int seed) {
+    const std::string path = dir + "/sketch-" + name + ".json";
+    writeVariantSketch(makeVariant(name), SketchNoise{}, seed, path);
+    std::ifstream in(path);
+    return Json::parse(in);
+  };
+  const size_t i4 = std::find(names.begin(), names.end(), "exp3-4") - names.begin();
+  ASSERT_LT(i4, names.size());
+  EXPECT_EQ(written("exp3-4", 2), makeSketch(makeVariant("exp3-4"), SketchNoise{}, 2 * 101 + i4));
+  // Variants do not share drawing errors: exp3-8 and exp4-static-obstacle sketch the same
+  // lab, seed for seed, with different noise.
+  EXPECT_NE(written("exp3-8", 2)["landmarks"], written("exp4-static-obstacle", 2)["landmarks"]);
 }
 
 TEST(ExperimentVariants, SketchNoiseIsSeeded) {
