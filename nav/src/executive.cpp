@@ -482,13 +482,12 @@ struct Executive::Impl {
     if (!classes.empty() && have_frame &&
         now - last_perception_t >= s.exec.perception_period_s - 1e-6) {
       last_perception_t = now;
-      // During the final look, where the sketch puts the landmark is handed to perception,
-      // which takes a foveal second look there (a full-resolution, upscaled crop) if the
-      // normal pass misses it: the landmark is 3-4 m away and small. Elsewhere the fovea is
-      // not used: in closed-loop runs it recognised landmarks twice as far away but did not
-      // make the goal estimate better, at ~35 ms per frame.
+      // Where the sketch puts each attended landmark is handed to perception, which takes a
+      // foveal second look there (a full-resolution, upscaled crop) if the normal pass
+      // misses it (~35 ms then): a landmark 3-6 m away is small. (When far sightings were
+      // dropped this bought nothing: landmarks recognised twice as far away, goal no better.)
       Observation ob;
-      if (final_looking && s.exec.final_look_fovea) {
+      if ((final_looking && s.exec.final_look_fovea) || s.exec.fovea_hints) {
         std::vector<LookFor> look;
         for (const auto& x : att)
           if (x.attend) look.push_back({x.lm->class_name, x.pred.bearing, x.pred.range});
