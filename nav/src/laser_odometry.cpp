@@ -143,7 +143,7 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   for (size_t i = 0; i < n; ++i) {
     const double r = sc.ranges[i];
     if (!std::isfinite(r) || r >= rmax || r < sc.min_range) continue;
-    const double a = sc.mount.theta + sc.angles[i];
+    const double a = sc.angles[i];  // a robot-frame bearing: the mount's yaw is in it already
     cur.insertPoint(static_cast<float>(sc.mount.x + r * std::cos(a)),
                     static_cast<float>(sc.mount.y + r * std::sin(a)), 0.f);
   }

@@ -154,6 +154,26 @@ TEST(LaserOdometry, SonarScansAreIgnored) {
   EXPECT_EQ(lo.stats().scans, 0);
 }
 
+// RangeScan::angles are robot-frame bearings (the mount's yaw included): a laser mounted
+// turned 0.4 rad must not have its points turned again, or the motion it measures comes out
+// turned too (here 0.2 m off sideways, refused).
+TEST(LaserOdometry, TakesTheBearingsOfATurnedLaserAsRobotFrame) {
+  LaserOdometry lo;
+  std::mt19937 rng(2);
+  auto scan = [&](double x, double t) {
+    auto s = scanAt({x, 1.2, 0}, room(), t, rng);
+    s.mount = {0, 0, 0.4};
+    return s;
+  };
+  lo.wheel({0, 0, 0}, 0.0);
+  lo.scan(scan(1.5, 0.0));
+  lo.wheel({0.45, 0, 0}, 1.0);  // the wheels say 0.45 m, the robot went 0.5 m
+  lo.scan(scan(2.0, 1.0));
+  EXPECT_EQ(lo.stats().aligned, 1);
+  EXPECT_NEAR(lo.pose().x, 0.5, 0.04);  // point-to-point ICP slides a little along the walls
+  EXPECT_NEAR(lo.pose().y, 0.0, 0.02);
+}
+
 TEST(LaserOdometry, ValidatesItsSettings) {
   LaserOdometryParams p;
   p.min_goodness = 1.5;
