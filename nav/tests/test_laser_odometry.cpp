@@ -154,6 +154,26 @@ TEST(LaserOdometry, SonarScansAreIgnored) {
   EXPECT_EQ(lo.stats().scans, 0);
 }
 
+// RangeScan::angles are robot-frame bearings (the mount's yaw included): a laser mounted
+// turned 0.4 rad must not have its points turned again, or the motion it measures comes out
+// turned too (here 0.2 m off sideways, refused).
+TEST(LaserOdometry, TakesTheBearingsOfATurnedLaserAsRobotFrame) {
+  LaserOdometry lo;
+  std::mt19937 rng(2);
+  auto scan = [&](double x, double t) {
+    auto s = scanAt({x, 1.2, 0}, room(), t, rng);
+    s.mount = {0, 0, 0.4};
+    return s;
+  };
+  lo.wheel({0, 0, 0}, 0.0);
+  lo.scan(scan(1.5, 0.0));
+  lo.wheel({0.45, 0, 0}, 1.0);  // the wheels say 0.45 m, the robot went 0.5 m
+  lo.scan(scan(2.0, 1.0));
+  EXPECT_EQ(lo.stats().aligned, 1);
+  EXPECT_NEAR(lo.pose().x, 0.5, 0.04);  // point-to-point ICP slides a little along the walls
+  EXPECT_NEAR(lo.pose().y, 0.0, 0.02);
+}
+
 TEST(LaserOdometry, ValidatesItsSettings) {
   LaserOdometryParams p;
   p.min_goodness = 1.5;
@@ -164,4 +184,71 @@ TEST(LaserOdometry, ValidatesItsSettings) {
   p = {};
   p.submap_keyframes = 0;
   EXPECT_THROW(LaserOdometry{p}, InputError);
+}
+
+namespace {
+// A furnished 16 x 11 m hall, its walls 3-8 m from the robot (1-degree beams land 5-14 cm apart
+// there): the robot weaves between a box and a bench 1 m apart (exp4-static-obstacle's detour)
+// while its wheels over-turn by 6 % and drift 0.01 rad/m. Returns the worst heading error
+// along the way as fixed_heading_err.
+Result weave(unsigned seed, LaserOdometryParams p = {}) {
+  std::mt19937 rng(seed);
+  std::vector<Seg> segs{{0, 0, 16, 0}, {16, 0, 16, 11}, {16, 11, 0, 11}, {0, 11, 0, 0}};
+  auto box = [&](double x0, double y0, double x1, double y1) {
+    segs.push_back({x0, y0, x1, y0});
+    segs.push_back({x1, y0, x1, y1});
+    segs.push_back({x1, y1, x0, y1});
+    segs.push_back({x0, y1, x0, y0});
+  };
+  box(7.7, 6.05, 8.3, 6.65);  // the box the robot goes round...
+  box(7.0, 7.72, 10.0, 8.3);  // ...and a bench 1 m beyond it
+  box(3.0, 2.0, 4.6, 2.8);
+  box(11.0, 3.5, 11.6, 4.5);
+  box(13.5, 9.0, 14.5, 10.4);
+  box(1.0, 9.6, 2.2, 10.4);
+  LaserOdometry lo(p);
+  const hw::Pose2D start{2.0, 6.3, 0};
+  hw::Pose2D truth = start, wheel{0, 0, 0};
+  const double dt = 0.05, v = 0.3;
+  Result r;
+  double worst = 0;
+  for (int k = 0; k * dt < 40; ++k) {
+    const double t = k * dt;
+    // Straight, left up to the gap, right through it and down past the box, straight again.
+    const double w = t < 12   ? 0.0
+                     : t < 16 ? 0.2
+                     : t < 20 ? -0.2
+                     : t < 24 ? -0.15
+                     : t < 28 ? 0.15
+                              : 0.0;
+    const double ds = v * dt, dth = w * dt;
+    truth.x += ds * std::cos(truth.theta);
+    truth.y += ds * std::sin(truth.theta);
+    truth.theta = wrapAngle(truth.theta + dth);
+    wheel.x += ds * std::cos(wheel.theta);
+    wheel.y += ds * std::sin(wheel.theta);
+    wheel.theta = wrapAngle(wheel.theta + 1.06 * dth + 0.01 * ds);
+    lo.wheel(wheel, t);
+    if (k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
+    worst = std::max(worst, std::abs(wrapAngle(lo.pose().theta - (truth.theta - start.theta))));
+  }
+  r.raw_heading_err = std::abs(wrapAngle(wheel.theta - (truth.theta - start.theta)));
+  r.fixed_heading_err = worst;
+  r.stats = lo.stats();
+  return r;
+}
+}  // namespace
+
+// The failure seen in exp4-static-obstacle #2: moving away from the keyframe, fewer beams
+// land where the keyframe's did, so ICP's own goodness (pairs within its final 2-4 cm
+// threshold) fell under min_goodness after 1-1.5 m although the alignments were right, and the
+// robot ran on its wheels through the detour. Here that refused 13-16 % of the scans and the
+// heading went 1.9-3.5 degrees off; the alignments must be kept.
+TEST(LaserOdometry, KeepsAligningAwayFromTheKeyframeInAWideHall) {
+  for (unsigned seed : {3u, 4u, 5u, 6u}) {
+    const Result r = weave(seed);
+    EXPECT_GT(r.raw_heading_err, 0.04) << seed;    // the wheels lose > 2.3 degrees...
+    EXPECT_LT(r.fixed_heading_err, 0.03) << seed;  // ...scan matching never more than 1.7
+    EXPECT_GT(r.stats.aligned, r.stats.scans * 95 / 100) << seed;
+  }
 }
