@@ -240,9 +240,15 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   stats_.ms_mean = I.ms_sum / stats_.attempts;
   const CPose2D rel = now_pose - I.kf_pose;
   // A refused alignment also starts a new keyframe once the robot is well away from the old
-  // one: aligning ever larger displacements only gets worse.
+  // one: aligning ever larger displacements only gets worse. And at once when the reference
+  // explains too little of the scan: the view has moved on (turning among obstacles, into a
+  // new room) and will only move further, while the wheels since the last alignment, 0.1 s
+  // ago, are still good. Waiting for twice keyframe_dist_m instead left exp2-redrawn-d #2's
+  // robot on its wheels for 6 s (64 scans) in a weave round obstacles: 1.8 degrees lost
+  // (replayed: final odometry error 0.47 m / 3.3 degrees -> 0.22 m / 1.0).
   const double k = ok ? 1.0 : 2.0;
-  if (std::hypot(rel.x(), rel.y()) >= k * params_.keyframe_dist_m ||
+  if ((!ok && overlap < params_.min_goodness) ||
+      std::hypot(rel.x(), rel.y()) >= k * params_.keyframe_dist_m ||
       std::abs(rel.phi()) >= k * params_.keyframe_deg * M_PI / 180)
     newKeyframe(now_pose);
 }

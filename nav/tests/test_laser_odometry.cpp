@@ -252,3 +252,51 @@ TEST(LaserOdometry, KeepsAligningAwayFromTheKeyframeInAWideHall) {
     EXPECT_GT(r.stats.aligned, r.stats.scans * 95 / 100) << seed;
   }
 }
+
+namespace {
+// Through a door from a 6 x 6 m room into an 8 x 9 m one and at once a quarter turn left,
+// wheels over-turning 6 %: the first room's keyframe explains little of the second.
+Result throughTheDoor(unsigned seed) {
+  std::mt19937 rng(seed);
+  std::vector<Seg> segs{
+      {0, 0, 14, 0},     {14, 0, 14, 9},     {14, 9, 0, 9},      {0, 9, 0, 0},
+      {0, 6, 6, 6},      {6, 9, 6, 6},       {6, 0, 6, 2.5},     {6, 3.5, 6, 6},
+      {9, 6.5, 10, 6.5}, {10, 6.5, 10, 7.5}, {10, 7.5, 9, 7.5},  {9, 7.5, 9, 6.5},
+      {12, 1, 13, 1},    {13, 1, 13, 1.6},   {13, 1.6, 12, 1.6}, {12, 1.6, 12, 1}};
+  LaserOdometry lo;
+  const hw::Pose2D start{2.0, 3.0, 0};
+  hw::Pose2D truth = start, wheel{0, 0, 0};
+  const double dt = 0.05, v = 0.3;
+  Result r;
+  for (int k = 0; k * dt < 30; ++k) {
+    const double t = k * dt;
+    const double w = truth.x > 6.6 && truth.theta < M_PI / 2 - 0.02 ? 0.3 : 0.0;
+    const double ds = v * dt, dth = w * dt;
+    truth.x += ds * std::cos(truth.theta);
+    truth.y += ds * std::sin(truth.theta);
+    truth.theta = wrapAngle(truth.theta + dth);
+    wheel.x += ds * std::cos(wheel.theta);
+    wheel.y += ds * std::sin(wheel.theta);
+    wheel.theta = wrapAngle(wheel.theta + 1.06 * dth);
+    lo.wheel(wheel, t);
+    if (k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
+    if (truth.y > 8.0) break;
+  }
+  r.raw_heading_err = std::abs(wrapAngle(wheel.theta - (truth.theta - start.theta)));
+  r.fixed_heading_err = std::abs(wrapAngle(lo.pose().theta - (truth.theta - start.theta)));
+  r.stats = lo.stats();
+  return r;
+}
+}  // namespace
+
+// Once the reference explains too little of the scan, waiting for the keyframe distance leaves
+// the robot on its wheels through the turn (here 3.7 degrees lost of the wheels' 5.4; the
+// exp2-redrawn-d #2 trial lost 1.8 in a weave): the keyframe must be renewed at once.
+TEST(LaserOdometry, RenewsTheKeyframeWhenTheViewMovesOn) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    const Result r = throughTheDoor(seed);
+    EXPECT_GT(r.raw_heading_err, 0.08) << seed;    // the wheels: 5.4 degrees off
+    EXPECT_LT(r.fixed_heading_err, 0.02) << seed;  // (0.5 at most)
+    EXPECT_GT(r.stats.aligned, r.stats.scans * 95 / 100) << seed;
+  }
+}

@@ -22,7 +22,10 @@
 // from 1.5 m further on is sampled at other places): judged by ICP's own goodness, which pairs
 // points only within 2-4 cm, correct alignments were refused once the robot was 1-1.5 m from
 // the keyframe, and in one experiment trial the robot then crossed a detour on its wheels alone
-// and lost 3-4 degrees of heading (now under 1.2 in the six trials measured).
+// and lost 3-4 degrees of heading. A scan the reference explains too little of (the view has
+// moved on: a turn among obstacles, a door) starts a new keyframe at once, placed by the
+// wheels (usually one scan since the last alignment), rather than leaving the robot on its
+// wheels until it is twice keyframe_dist_m from the old one.
 #include <deque>
 #include <memory>
 
