@@ -101,6 +101,27 @@ TEST(Avoider, StepsAwayFromSomeoneComingTowardsItOffToOneSide) {
   }
 }
 
+TEST(Avoider, StepsOutOfAWalkersLaneNotAlongIt) {
+  // A person walks at the robot 0.3 m left of its heading, which is the route's direction: the
+  // dodge (to the right, away from them) heads at least half the walker side-bias off the
+  // route, out of their lane, not along its edge.
+  AvoidParams p;
+  ObstacleAvoider a(p);
+  a.setPose({0, 0, 0});
+  AvoidOutput out;
+  int active = 0;
+  for (int k = 0; k < 40; ++k) {
+    auto scan = laser({{3.2 - 0.05 * k, 0.3, 0.25}}, {-2.0});
+    scan.stamp = 0.1 * k;
+    out = a.step({scan}, 0.0, DodgeSide::Left, 0.0, 0.3, 0.1 * k);
+    if (!out.active) continue;
+    ++active;
+    EXPECT_EQ(out.side, DodgeSide::Right);
+    EXPECT_LE(out.direction, -0.5 * p.moving_side_bias_deg * M_PI / 180 + 1e-9) << k;
+  }
+  EXPECT_GT(active, 5);
+}
+
 TEST(Avoider, TakesTheOtherSideWhenTheLandmarkSideIsClosed) {
   // Obstacle ahead, a wall 0.45 m to the left: dodging left is impossible.
   ObstacleAvoider a;
