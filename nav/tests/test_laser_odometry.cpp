@@ -18,15 +18,18 @@ namespace {
 struct Seg {
   double ax, ay, bx, by;
 };
+// The outline of an axis-aligned box [x0, x1] x [y0, y1], appended to `s`.
+void addBox(std::vector<Seg>& s, double x0, double y0, double x1, double y1) {
+  s.push_back({x0, y0, x1, y0});
+  s.push_back({x1, y0, x1, y1});
+  s.push_back({x1, y1, x0, y1});
+  s.push_back({x0, y1, x0, y0});
+}
 // A 10 x 7 m room with a table and a cabinet (world frame), as line segments.
 std::vector<Seg> room() {
-  std::vector<Seg> s{{0, 0, 10, 0}, {10, 0, 10, 7}, {10, 7, 0, 7}, {0, 7, 0, 0}};
-  auto box = [&](double x0, double y0, double x1, double y1) {
-    s.push_back({x0, y0, x1, y0});
-    s.push_back({x1, y0, x1, y1});
-    s.push_back({x1, y1, x0, y1});
-    s.push_back({x0, y1, x0, y0});
-  };
+  std::vector<Seg> s;
+  addBox(s, 0, 0, 10, 7);
+  auto box = [&](double x0, double y0, double x1, double y1) { addBox(s, x0, y0, x1, y1); };
   box(3, 2.5, 4.6, 3.3);
   box(7.5, 5.6, 8.2, 6.6);
   box(1.0, 5.5, 1.4, 5.9);
@@ -193,13 +196,9 @@ namespace {
 // along the way as fixed_heading_err.
 Result weave(unsigned seed, LaserOdometryParams p = {}) {
   std::mt19937 rng(seed);
-  std::vector<Seg> segs{{0, 0, 16, 0}, {16, 0, 16, 11}, {16, 11, 0, 11}, {0, 11, 0, 0}};
-  auto box = [&](double x0, double y0, double x1, double y1) {
-    segs.push_back({x0, y0, x1, y0});
-    segs.push_back({x1, y0, x1, y1});
-    segs.push_back({x1, y1, x0, y1});
-    segs.push_back({x0, y1, x0, y0});
-  };
+  std::vector<Seg> segs;
+  addBox(segs, 0, 0, 16, 11);
+  auto box = [&](double x0, double y0, double x1, double y1) { addBox(segs, x0, y0, x1, y1); };
   box(7.7, 6.05, 8.3, 6.65);  // the box the robot goes round...
   box(7.0, 7.72, 10.0, 8.3);  // ...and a bench 1 m beyond it
   box(3.0, 2.0, 4.6, 2.8);
