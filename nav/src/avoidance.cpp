@@ -294,13 +294,13 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   // towards the chosen side (then the other side): a stable tangent around the obstacle.
   const double open_m = P.trigger_m;
   auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= open_m; };
-  const double rel = wrapAngle(dir - target_bearing) * sgn;  // > 0: on the chosen side
+  // On the chosen side of the route direction, or not more than 0.35 rad the other way.
   // Against someone coming towards the robot, a direction close to the route's runs along
   // their lane: at least half the side bias out of it (an exp4-pedestrian-left robot drifted
   // along the walker's lane at 0.12 m/s sideways and was walked into 0.08 m from clear).
   const double min_rel = moving > 0 ? 0.5 * P.moving_side_bias_deg * M_PI / 180 : -0.35;
-  auto sided = [&](double a) { return wrapAngle(a - target_bearing) * sgn >= min_rel; };
-  const bool nd_ok = no.desiredSpeed > 0.05 && open(dir) && rel > min_rel && std::abs(dir) < 2.0;
+  auto sided = [&](double a) { return wrapAngle(a - target_bearing) * sgn > min_rel; };
+  const bool nd_ok = no.desiredSpeed > 0.05 && open(dir) && sided(dir) && std::abs(dir) < 2.0;
   bool found = nd_ok;
   // Hysteresis: a direction chosen before (kept in the odometry frame) that is still open is
   // kept, so the robot does not swing between two gaps while the target bearing moves.

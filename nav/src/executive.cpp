@@ -539,12 +539,11 @@ struct Executive::Impl {
         t.last_range = range;
         t.last_bearing = d.bearing;
         // Far ranges may be something else along the bearing; the bearing still helps.
-        {
+        const bool far = range > fixRange();
+        if (!far || s.exec.fit_bearing_only) {
           if (t.sightings.size() >= 80) t.sightings.erase(t.sightings.begin());
-          const bool far = range > fixRange();
-          if (!far || s.exec.fit_bearing_only)
-            t.sightings.push_back(
-                {{pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0});
+          t.sightings.push_back(
+              {{pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0});
         }
         if (n == 0) {
           const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
@@ -1036,6 +1035,11 @@ struct Executive::Impl {
       auto toward = [&](const Eigen::Vector2d& d) -> Eigen::Vector2d {
         return lf.bearing_only ? Eigen::Vector2d(across * across.dot(d)) : d;
       };
+      // Shift the route `gain` of the way to the fix, as the route stands then.
+      auto reanchorOn = [&](double gain) {
+        const Eigen::Vector2d at = tracker.toOdom(lm.position_m);
+        tracker.reanchor(lm.position_m, at + toward(seen - at), gain);
+      };
       const Eigen::Vector2d shift = toward(seen - tracker.toOdom(lm.position_m));
       fixes_route.push_back(lm.position_m);
       fixes_odom.push_back(seen);
@@ -1044,7 +1048,7 @@ struct Executive::Impl {
       fixes_across.push_back(across);
       // With enough fixes spread far enough: refit rotation, scale and translation to the
       // last fit_fixes of them (the start counts as one) by least squares, then pull the route
-      // part of the way to this one (hand-drawn maps are also locally distorted).
+      // fit_local_gain of the way to this one (0 by default, see executive.h).
       const size_t n = std::min<size_t>(fixes_route.size(), std::max(0, s.exec.fit_fixes));
       std::vector<size_t> idx;  // the fixes fitted: the last n (and the start, if asked)
       if (s.exec.fit_keep_start && fixes_route.size() > n) idx.push_back(0);
@@ -1067,11 +1071,7 @@ struct Executive::Impl {
           f = tracker.fitSimilarity(fr, fo, s.exec.fit_max_scale_change, s.exec.fit_outlier_m);
         }
         // Not towards the newest fix when the fit found it an outlier.
-        if (f.used.empty() || f.used.back())
-          tracker.reanchor(
-              lm.position_m,
-              tracker.toOdom(lm.position_m) + toward(seen - tracker.toOdom(lm.position_m)),
-              s.exec.fit_local_gain);
+        if (f.used.empty() || f.used.back()) reanchorOn(s.exec.fit_local_gain);
         e["fit_rotation_deg"] = f.rotation * 180 / M_PI;
         e["fit_scale"] = tracker.scale();
         e["fit_rms_m"] = f.rms;
@@ -1082,10 +1082,7 @@ struct Executive::Impl {
                                ? 0.0
                                : tracker.realign(lm.position_m, seen, fix_route, fix_odom,
                                                  s.exec.realign_gain, s.exec.realign_baseline_m);
-        tracker.reanchor(
-            lm.position_m,
-            tracker.toOdom(lm.position_m) + toward(seen - tracker.toOdom(lm.position_m)),
-            s.exec.reanchor_gain);
+        reanchorOn(s.exec.reanchor_gain);
         e["realign_deg"] = rot * 180 / M_PI;
         e["reanchor_m"] = shift.norm() * s.exec.reanchor_gain;
       }

@@ -247,7 +247,7 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   // robot on its wheels for 6 s (64 scans) in a weave round obstacles: 1.8 degrees lost
   // (replayed: final odometry error 0.47 m / 3.3 degrees -> 0.22 m / 1.0).
   const double k = ok ? 1.0 : 2.0;
-  if ((!ok && overlap < params_.min_goodness) ||
+  if (overlap < params_.min_goodness ||
       std::hypot(rel.x(), rel.y()) >= k * params_.keyframe_dist_m ||
       std::abs(rel.phi()) >= k * params_.keyframe_deg * M_PI / 180)
     newKeyframe(now_pose);
