@@ -39,6 +39,8 @@ void AvoidParams::validate() const {
   require(moving_side_bias_deg >= 0 && moving_side_bias_deg < 90, "nav.avoid.moving_side_bias_deg",
           "must be in [0, 90)");
   require(moving_away_m >= 0, "nav.avoid.moving_away_m", "must be >= 0 m");
+  require(route_cone_deg > 0 && route_cone_deg <= 150, "nav.avoid.route_cone_deg",
+          "must be in (0, 150]");
   require(same_side_s >= 0, "nav.avoid.same_side_s", "must be >= 0");
   require(min_active_s >= 0, "nav.avoid.min_active_s", "must be >= 0");
   require(k_heading > 0, "nav.avoid.k_heading", "must be > 0");
@@ -300,32 +302,50 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   // along the walker's lane at 0.12 m/s sideways and was walked into 0.08 m from clear).
   const double min_rel = moving > 0 ? 0.5 * P.moving_side_bias_deg * M_PI / 180 : -0.35;
   auto sided = [&](double a) { return wrapAngle(a - target_bearing) * sgn > min_rel; };
-  const bool nd_ok = no.desiredSpeed > 0.05 && open(dir) && sided(dir) && std::abs(dir) < 2.0;
+  // The first open direction from the route's, towards the chosen side, then the other side,
+  // for deviations in [lo, hi] (a walker's lane: from the least way out of it on the chosen
+  // side).
+  auto search = [&](double lo, double hi, double& out_dir) {
+    const double step = 5 * M_PI / 180;
+    for (int pass = 0; pass < 2; ++pass) {
+      const double s2 = pass == 0 ? sgn : -sgn;
+      const double off0 = std::max(lo, pass == 0 && moving > 0 ? min_rel : 0.0);
+      for (double off = off0; off <= hi + 1e-9; off += step) {
+        const double a = wrapAngle(target_bearing + s2 * off);
+        if (std::abs(a) <= 2.2 && open(a)) {
+          out_dir = a;
+          return true;
+        }
+      }
+    }
+    return false;
+  };
+  // Within the route cone, the chosen side may cost any detour, but a direction outside it is
+  // taken only when nothing inside is open: with "on the chosen side" alone, ND or the kept
+  // direction led an exp4-pedestrian-right robot 150-180 deg away from the route for 6 s, back
+  // into the walker's lane, while the way on along the route's side of the bench was open.
+  const double cone = P.route_cone_deg * M_PI / 180;
+  auto in_cone = [&](double a) { return std::abs(wrapAngle(a - target_bearing)) <= cone + 1e-9; };
+  double cone_dir = 0;
+  const bool cone_open = search(0.0, cone, cone_dir);
+  auto allowed = [&](double a) { return in_cone(a) || !cone_open; };
+  const bool nd_ok =
+      no.desiredSpeed > 0.05 && open(dir) && sided(dir) && allowed(dir) && std::abs(dir) < 2.0;
   bool found = nd_ok;
   // Hysteresis: a direction chosen before (kept in the odometry frame) that is still open is
   // kept, so the robot does not swing between two gaps while the target bearing moves.
   if (!found && have_prev_) {
     const double a = wrapAngle(prev_dir_odom_ - heading);
-    if (std::abs(a) <= 2.2 && open(a) && (moving <= 0 || sided(a))) {
+    if (std::abs(a) <= 2.2 && open(a) && (moving <= 0 || sided(a)) && allowed(a)) {
       dir = a;
       found = true;
     }
   }
-  if (!found) {
-    const double step = 5 * M_PI / 180;
-    for (int pass = 0; pass < 2 && !found; ++pass) {
-      const double s2 = pass == 0 ? sgn : -sgn;
-      // (from the least way out of a walker's lane on the chosen side)
-      const double off0 = pass == 0 && moving > 0 ? min_rel : 0.0;
-      for (double off = off0; off <= 150 * M_PI / 180 && !found; off += step) {
-        const double a = wrapAngle(target_bearing + s2 * off);
-        if (std::abs(a) <= 2.2 && open(a)) {
-          dir = a;
-          found = true;
-        }
-      }
-    }
+  if (!found && cone_open) {
+    dir = cone_dir;
+    found = true;
   }
+  if (!found) found = search(cone, 150 * M_PI / 180, dir);
   double speed = 1.0;
   if (!found) {  // boxed in: turn on the spot towards the chosen side
     dir = sgn * 1.2;

@@ -4,6 +4,7 @@
 
 #include <cmath>
 
+#include "scan_sim.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/nav/avoidance.h"
 
@@ -120,6 +121,49 @@ TEST(Avoider, StepsOutOfAWalkersLaneNotAlongIt) {
     EXPECT_LE(out.direction, -0.5 * p.moving_side_bias_deg * M_PI / 180 + 1e-9) << k;
   }
   EXPECT_GT(active, 5);
+}
+
+TEST(Avoider, DoesNotTurnBackAlongTheWayItCame) {
+  // The exp4-pedestrian-right scene: a dodge to the right (round someone, now gone) is under way
+  // when the robot faces a bench 0.9 m away (heading -75 deg); the route goes on past the
+  // bench's east end, so the direction to it grazes the corner. Right, all the way round, is the
+  // way back west along the bench; the way on along it to the east is open. Closed loop, 10 Hz.
+  const std::vector<test::Box> scene{{-0.2, -1.1, 1.8, 0.4}};  // x in [-2, 1.6], y in [-1.5, -0.7]
+  const Eigen::Vector2d route(3.0, -1.5);
+  for (const double dy : {-0.1, 0.0, 0.1}) {
+    ObstacleAvoider a;
+    hw::Pose2D pose{0, 0.2 + dy, -1.3};
+    double min_x = pose.x;
+    bool dodged = false, arrived = false;
+    {  // the manoeuvre started round something ahead, to the right, before the bench was near
+      const test::Disc ahead{pose.x + 0.8 * std::cos(pose.theta),
+                             pose.y + 0.8 * std::sin(pose.theta), 0.25};
+      a.setPose(pose);
+      const auto out = a.step({test::scanAt(pose, {}, {ahead}, 0.0)}, 0.0, DodgeSide::Right,
+                              pose.theta, 0.3, 0.0);
+      ASSERT_TRUE(out.started);
+      ASSERT_EQ(out.side, DodgeSide::Right);
+    }
+    for (int k = 1; k < 300 && !arrived; ++k) {
+      const double t = 0.1 * k;
+      const double tb =
+          std::remainder(std::atan2(route.y() - pose.y, route.x() - pose.x) - pose.theta, 2 * M_PI);
+      a.setPose(pose);
+      const auto out =
+          a.step({test::scanAt(pose, scene, {}, t)}, tb, DodgeSide::Right, pose.theta, 0.3, t);
+      dodged |= out.active;
+      const double v = out.active ? out.v : 0.3 * std::max(0.0, std::cos(tb));
+      const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
+      pose.x += v * std::cos(pose.theta) * 0.1;
+      pose.y += v * std::sin(pose.theta) * 0.1;
+      pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+      min_x = std::min(min_x, pose.x);
+      arrived = std::hypot(route.x() - pose.x, route.y() - pose.y) < 0.4;
+    }
+    EXPECT_TRUE(dodged) << dy;
+    EXPECT_GT(min_x, -0.5) << dy;  // did not go back west along the bench
+    EXPECT_TRUE(arrived) << dy;
+  }
 }
 
 TEST(Avoider, TakesTheOtherSideWhenTheLandmarkSideIsClosed) {

@@ -37,6 +37,9 @@ struct AvoidParams {
   double moving_away_m = 0.15;       // [m] an obstacle coming towards the robot this far or
                                      // more to one side of its heading: dodge to the other
                                      // side, not the landmark's (0 = always the landmark's)
+  double route_cone_deg = 90;        // [deg] a direction further than this from the route's is
+                                     // taken only when none within it is open: the chosen side
+                                     // is kept round an obstacle, not all the way back
   double min_active_s = 1.0;         // [s] hold a manoeuvre at least this long (no chattering)
   double same_side_s = 3.0;          // [s] a manoeuvre starting this soon after the last one
                                      // ended dodges to the same side
@@ -57,6 +60,7 @@ struct AvoidParams {
     b("side_bias_deg", side_bias_deg);
     b("moving_side_bias_deg", moving_side_bias_deg);
     b("moving_away_m", moving_away_m);
+    b("route_cone_deg", route_cone_deg);
     b("min_active_s", min_active_s);
     b("same_side_s", same_side_s);
     b("k_heading", k_heading);
