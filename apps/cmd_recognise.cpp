@@ -132,6 +132,8 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
                            {"votes", r.votes},
                            {"vote_share", r.vote_share},
                            {"bow_probability", r.bow_probability},
+                           {"colour_probability", r.colour_probability},
+                           {"colour_rescued", r.colour_rescued},
                            {"evidence", r.evidence},
                            {"rejected", r.rejected}});
         *runner.details << Json{{"image", path},
@@ -294,6 +296,8 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
                        {"evidence", r.evidence},
                        {"votes", r.votes},
                        {"bow_probability", r.bow_probability},
+                       {"colour_probability", r.colour_probability},
+                       {"colour_rescued", r.colour_rescued},
                        {"rejected", r.rejected},
                        {"window", {r.window.x, r.window.y, r.window.width, r.window.height}}});
     const bool rejected = res.empty() || res.front().rejected;

@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "matcher_internal.h"
+#include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/recognition.h"
 
 namespace sketchnav::landmarks {
@@ -19,14 +20,17 @@ void RecognitionParams::validate() const {
           "must be >= 0 (0 = no limit)");
   require(reject_probability >= 0 && reject_probability <= 1, "recognition.reject_probability",
           "must be in [0, 1]");
+  require(colour_rescue_inliers >= 0, "recognition.colour_rescue_inliers",
+          "must be >= 0 (0 = off)");
   match.validate();
 }
 
 double RecognitionParams::combinedScore(int inliers, int votes, int total_votes, double bow_p,
-                                        bool verified) const {
+                                        bool verified, double colour_p) const {
   const double vote_share = total_votes > 0 ? static_cast<double>(votes) / total_votes : 0.0;
   return score_bias + score_inliers * std::log1p(inliers) + score_vote_share * vote_share +
-         score_votes * std::log1p(votes) + score_bow * bow_p + (verified ? score_verified : 0.0);
+         score_votes * std::log1p(votes) + score_bow * bow_p + (verified ? score_verified : 0.0) +
+         score_colour * colour_p;
 }
 
 namespace {
@@ -68,10 +72,26 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return prob[a] > prob[b]; });
 
+  // Colour-layout evidence: one descriptor per window, over its keypoints' box (colour_layout.h
+  // says why that region), scored by every class's colour classifier.
+  std::vector<float> colour_p(n_classes, 0.0f);
+  if (!frame.colour_thumbnail.empty() && model.colourClassifier().classes() == n_classes) {
+    std::vector<cv::Point2f> pts;
+    pts.reserve(idx.size());
+    for (int i : idx) pts.push_back(frame.features.keypoints[i].pt);
+    const cv::Size size = frame.features.image_size;
+    colour_p = model.colourClassifier().probabilities(
+        colourLayoutDescriptor(frame.colour_thumbnail, size, colourRegion(pts, size, win)));
+  }
+  const int colour_best =
+      static_cast<int>(std::max_element(colour_p.begin(), colour_p.end()) - colour_p.begin());
+  const bool have_colour = !frame.colour_thumbnail.empty() && n_classes > 1;
+
   auto entry = [&](int c) {
     Recognition r;
     r.class_name = model.classes()[c];
     r.bow_probability = prob[c];
+    r.colour_probability = colour_p[c];
     r.score = prob[c];
     r.window = win;
     return r;
@@ -160,8 +180,8 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   int total_votes = 0;
   for (int v : votes.class_votes) total_votes += v;
   auto evidence = [&](int c) {
-    return static_cast<float>(
-        p.combinedScore(ev[c].inliers, votes.class_votes[c], total_votes, prob[c], ev[c].verified));
+    return static_cast<float>(p.combinedScore(ev[c].inliers, votes.class_votes[c], total_votes,
+                                              prob[c], ev[c].verified, colour_p[c]));
   };
   auto make = [&](int c) {
     Recognition r = entry(c);
@@ -211,7 +231,20 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
     out.push_back(make(c));
     used.insert(c);
   }
-  const bool none = verified.empty();
+  bool none = verified.empty();
+  // Colour rescue: no class verified, but the class with most votes found some inliers and is
+  // also the colour classifier's first choice.
+  if (none && p.colour_rescue_inliers > 0 && have_colour && !shortlist.empty()) {
+    const int c = shortlist.front();  // sorted by votes (then BoW) above
+    if (p.rank_by_votes && votes.class_votes[c] > 0 && ev[c].inliers >= p.colour_rescue_inliers &&
+        c == colour_best) {
+      Recognition r = make(c);
+      r.colour_rescued = true;
+      out.push_back(r);
+      used.insert(c);
+      none = false;
+    }
+  }
   // The remaining candidates, unverified, in the ranking's order.
   std::vector<int> rest = order;
   if (p.rank_by_votes)

@@ -60,9 +60,15 @@ struct RecognitionParams {
   double score_votes = 0.94;       // × ln(1 + votes)
   double score_bow = 1.5;          // × calibrated SVM probability
   double score_verified = -0.7;    // + when the class reached min_inliers (colour-checked)
+  double score_colour = 0.0;       // × calibrated colour-layout probability (colour_layout.h)
   double accept_score = -4.0;  // log-odds; the best class below it -> "none of these" (chosen on
                                // val: the old rule's top-1; held-out train photos suggest ~0)
-  MatchParams match;           // verification settings (min_inliers is the reject threshold)
+  // Colour rescue (default rule; 0 = off): when no class verifies, the class with most votes is
+  // the answer anyway if its best photo gave at least this many inliers AND the colour-layout
+  // classifier (colour_layout.h) ranks it first of all classes — two independent cues (local
+  // texture votes, global colour) agreeing on a class whose geometry fell just short.
+  int colour_rescue_inliers = 0;
+  MatchParams match;  // verification settings (min_inliers is the reject threshold)
 
   template <class B>
   void bind(B& b) {
@@ -86,6 +92,8 @@ struct RecognitionParams {
     b("score_bow", score_bow);
     b("score_verified", score_verified);
     b("accept_score", accept_score);
+    b("score_colour", score_colour);
+    b("colour_rescue_inliers", colour_rescue_inliers);
     b("ratio", match.ratio);
     b("min_inliers", match.min_inliers);
     b("ransac_px", match.ransac_px);
@@ -98,13 +106,17 @@ struct RecognitionParams {
   }
   void validate() const;
   /// The combined evidence score (log-odds that the class is the one in the window).
-  double combinedScore(int inliers, int votes, int total_votes, double bow_p, bool verified) const;
+  double combinedScore(int inliers, int votes, int total_votes, double bow_p, bool verified,
+                       double colour_p = 0) const;
 };
 
 struct Recognition {
   std::string class_name;
   float score = 0;  // verified: match confidence in [0,1); BoW-only: calibrated p
   float bow_probability = 0;
+  float colour_probability = 0;  // colour-layout classifier's calibrated p for the class, over
+                                 // the window's keypoint region (0 when the frame is grey)
+  bool colour_rescued = false;   // accepted by colour_rescue_inliers, not verified
   int inliers = 0;        // RANSAC inliers against the best database photo tried (0 = not tried);
                           // may be below min_inliers (see verified)
   int vote_inliers = 0;   // RANSAC inliers among the vote correspondences only (matches that
