@@ -20,6 +20,9 @@ void RecognitionParams::validate() const {
           "must be >= 0 (0 = no limit)");
   require(reject_probability >= 0 && reject_probability <= 1, "recognition.reject_probability",
           "must be in [0, 1]");
+  require(colour_rescue_rank >= 1, "recognition.colour_rescue_rank", "must be >= 1");
+  require(colour_rescue_probability >= 0 && colour_rescue_probability <= 1,
+          "recognition.colour_rescue_probability", "must be in [0, 1]");
   require(colour_rescue_inliers >= 0, "recognition.colour_rescue_inliers",
           "must be >= 0 (0 = off)");
   match.validate();
@@ -232,12 +235,15 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
     used.insert(c);
   }
   bool none = verified.empty();
-  // Colour rescue: no class verified, but the class with most votes found some inliers and is
-  // also the colour classifier's first choice.
-  if (none && p.colour_rescue_inliers > 0 && have_colour && !shortlist.empty()) {
-    const int c = shortlist.front();  // sorted by votes (then BoW) above
-    if (p.rank_by_votes && votes.class_votes[c] > 0 && ev[c].inliers >= p.colour_rescue_inliers &&
-        c == colour_best) {
+  // Colour rescue: no class verified, but one of the classes with most votes is also the colour
+  // classifier's confident first choice.
+  if (none && p.colour_rescue && have_colour && p.rank_by_votes) {
+    const int c = colour_best;
+    std::vector<int> by_votes = shortlist;  // sorted by votes (then BoW) above
+    by_votes.resize(std::min<size_t>(by_votes.size(), p.colour_rescue_rank));
+    if (std::find(by_votes.begin(), by_votes.end(), c) != by_votes.end() &&
+        votes.class_votes[c] > 0 && colour_p[c] >= p.colour_rescue_probability &&
+        ev[c].inliers >= p.colour_rescue_inliers) {
       Recognition r = make(c);
       r.colour_rescued = true;
       out.push_back(r);

@@ -1,5 +1,5 @@
 // Colour-layout descriptor and its use as recognition evidence (colour_layout.h,
-// RecognitionParams::score_colour / colour_rescue_inliers).
+// RecognitionParams::score_colour / colour_rescue).
 #include <gtest/gtest.h>
 
 #include <opencv2/imgproc.hpp>
@@ -184,7 +184,7 @@ TEST_F(TwinModel, ColourEvidenceSeparatesClassesOfIdenticalTexture) {
 
 TEST_F(TwinModel, ColourRescueAcceptsAVotedClassBelowMinInliersOnlyWhenColourAgrees) {
   // min_inliers out of reach: nothing verifies, so the default rule rejects; the rescue accepts
-  // the class with most votes when it has some inliers and colour ranks it first. "other" has
+  // a class with most votes when it has some inliers and colour ranks it first. "other" has
   // its own texture, so it gets votes (the twins' votes tie away). Keypoint colours off, so the
   // votes follow the texture alone whatever the view's colours.
   const cv::Mat v = test::randomView(test::texturedImage(240, 180, 77), 320, 240, 950, 15);
@@ -192,9 +192,11 @@ TEST_F(TwinModel, ColourRescueAcceptsAVotedClassBelowMinInliersOnlyWhenColourAgr
   p.match.colour_tolerance = 0;
   p.match.min_inliers = 1000;
   p.match.strong_inliers = 2000;
+  p.colour_rescue = false;
   const auto none = recognise(*model_, v, {}, 3, p);
   ASSERT_FALSE(none.empty());
   EXPECT_TRUE(none[0].rejected);
+  p.colour_rescue = true;
   p.colour_rescue_inliers = 6;
   const auto rescued = recognise(*model_, v, {}, 3, p);
   ASSERT_FALSE(rescued.empty());
