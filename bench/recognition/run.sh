@@ -23,7 +23,8 @@
 #   min16, min16_no_colour_rescue  min_inliers 16 (stricter verification), with and without the
 #                    colour rescue (also rejection_min16*): the top-1 / rejection trade-off
 #   demo             the product's 8-class demo set (share/landmarks) on all val photos in
-#                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected)
+#                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected);
+#                    demo_no_colour_rescue the same without the colour rescue
 #
 # Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
 # Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean, and per
@@ -91,6 +92,7 @@ evaluate rejection_min16_no_colour_rescue rootsift_excluded $MIN16 $NO_RESCUE
 evaluate rejection_no_colour rootsift_excluded $NO_COLOUR
 evaluate rejection_combined rootsift_excluded $COMBINED
 evaluate demo demo --frame 640x480 --match
+evaluate demo_no_colour_rescue demo --frame 640x480 --match $NO_RESCUE
 
 python3 - "$OUT" <<'PY'
 import json, os, sys
