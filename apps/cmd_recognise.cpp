@@ -308,8 +308,12 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (!g.json) {
       std::cout << path << ": " << (rejected ? "none of these" : res.front().class_name) << "\n";
       for (const auto& r : res)
-        std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f%s\n", r.class_name.c_str(),
-                    r.score, r.inliers, r.bow_probability, r.rejected ? "  (not verified)" : "");
+        std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f  colour p %.3f%s\n",
+                    r.class_name.c_str(), r.score, r.inliers, r.bow_probability,
+                    r.colour_probability,
+                    r.rejected         ? "  (not verified)"
+                    : r.colour_rescued ? "  (not verified; votes and colour agree)"
+                                       : "");
     }
   }
   if (g.json) printJson({{"results", out}, {"unreadable", unreadable}, {"mode", modeJson(runner)}});

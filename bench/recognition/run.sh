@@ -5,7 +5,8 @@
 #   rootsift         RootSIFT + BoW/SVM + NN votes + colour-checked geometric verification
 #                    + colour rescue (the product's defaults)
 #   no_colour_rescue the same without the colour-layout rescue (colour_rescue=false): the
-#                    colour-layout evidence's contribution (also frame_*, rejection_*)
+#                    colour-layout evidence's contribution (also frame_*, windows_*,
+#                    rejection_*, demo_*)
 #   rootsift_bow     the same model, BoW + linear SVM only (the classic pipeline)
 #   sift, sift_bow   plain SIFT instead of RootSIFT
 #   no_colour        the product without the keypoint colour check (colour_tolerance 0)
@@ -79,6 +80,7 @@ evaluate sift sift
 evaluate sift_bow sift --no-verify
 evaluate no_colour rootsift $NO_COLOUR
 evaluate windows rootsift --windows 10
+evaluate windows_no_colour_rescue rootsift --windows 10 $NO_RESCUE
 evaluate frame rootsift --frame 640x480 --match
 evaluate frame_no_colour_rescue rootsift --frame 640x480 --match $NO_RESCUE
 evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
