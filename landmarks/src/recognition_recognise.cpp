@@ -23,8 +23,7 @@ void RecognitionParams::validate() const {
   require(colour_rescue_rank >= 1, "recognition.colour_rescue_rank", "must be >= 1");
   require(colour_rescue_probability >= 0 && colour_rescue_probability <= 1,
           "recognition.colour_rescue_probability", "must be in [0, 1]");
-  require(colour_rescue_inliers >= 0, "recognition.colour_rescue_inliers",
-          "must be >= 0 (0 = off)");
+  require(colour_rescue_inliers >= 0, "recognition.colour_rescue_inliers", "must be >= 0");
   match.validate();
 }
 
@@ -300,10 +299,13 @@ std::vector<Recognition> recognise(const LandmarkModel& model, const FrameFeatur
     all.insert(all.end(), v.begin(), v.end());
   // Best first: accepted before rejected, then the same order as within a window.
   auto key = [&](const Recognition& r) {
-    if (p.combined_score) return std::make_tuple(!r.rejected, r.evidence, 0, 0.0f);
-    return p.rank_by_votes
-               ? std::make_tuple(!r.rejected, static_cast<float>(r.votes), r.inliers, r.score)
-               : std::make_tuple(!r.rejected, static_cast<float>(r.inliers), r.votes, r.score);
+    // Verified before colour-rescued: a rescued class of one window must not displace a class
+    // another window verified.
+    if (p.combined_score) return std::make_tuple(!r.rejected, true, r.evidence, 0, 0.0f);
+    return p.rank_by_votes ? std::make_tuple(!r.rejected, !r.colour_rescued,
+                                             static_cast<float>(r.votes), r.inliers, r.score)
+                           : std::make_tuple(!r.rejected, !r.colour_rescued,
+                                             static_cast<float>(r.inliers), r.votes, r.score);
   };
   std::stable_sort(all.begin(), all.end(),
                    [&](const Recognition& a, const Recognition& b) { return key(a) > key(b); });
