@@ -96,6 +96,13 @@ def table(rows, w, name):
     print("  old rule (first verified by votes): top-1 %.3f, false rejections %.3f, unknown rejected %s" %
           (old_ok / max(1, len(known)), old_frej / max(1, len(known)),
            "%.3f" % (old_rej / len(unknown)) if unknown else "-"))
+    # The pipeline's own answer as run (the default rule plus the colour rescue, or whatever
+    # --set chose): the first candidate when it is not rejected.
+    ran = lambda r: r["candidates"][0]["class"] if r["candidates"] and not r["candidates"][0]["rejected"] else None
+    print("  as run (first candidate unless rejected): top-1 %.3f, false rejections %.3f, unknown rejected %s" %
+          (sum(1 for r in known if ran(r) == r["class"]) / max(1, len(known)),
+           sum(1 for r in known if ran(r) is None) / max(1, len(known)),
+           "%.3f" % (sum(1 for r in unknown if ran(r) is None) / len(unknown)) if unknown else "-"))
     print("  accept_score | top-1 | false rejections | unknown rejected")
     for t in [-3, -2.5, -2, -1.5, -1, -0.5, 0, 0.5, 1, 1.5, 2, 3]:
         ok = sum(1 for (s, cls), r in dec if r["known"] and s >= t and cls == r["class"])
