@@ -258,3 +258,51 @@ TEST(RecognitionParams, ColourRescueMustNotBeNegative) {
     EXPECT_NE(std::string(e.what()).find("colour_rescue_inliers"), std::string::npos);
   }
 }
+
+namespace {
+// `img` with a sinusoidal displacement (amplitude `amp` px): local patches (and so their SIFT
+// descriptors and votes) survive, a single homography does not.
+cv::Mat wavy(const cv::Mat& img, float amp, float period) {
+  cv::Mat mx(img.size(), CV_32F), my(img.size(), CV_32F);
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) {
+      mx.at<float>(y, x) = x + amp * std::sin(2 * static_cast<float>(CV_PI) * y / period);
+      my.at<float>(y, x) = y + amp * std::sin(2 * static_cast<float>(CV_PI) * x / period);
+    }
+  cv::Mat out;
+  cv::remap(img, out, mx, my, cv::INTER_LINEAR, cv::BORDER_REFLECT);
+  return out;
+}
+}  // namespace
+
+TEST_F(TwinModel, AcrossWindowsAVerifiedClassOutranksAColourRescuedOne) {
+  // Left window: a small clean view of "red" (verifies, few votes). Right window: a large,
+  // wavy view of "other" (many votes, no homography): colour-rescued at best.
+  const cv::Mat tex = test::texturedImage(240, 180, 4242);
+  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  test::randomView(tinted(tex, {40, 40, 255}), 320, 240, 77, 5)
+      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
+  wavy(test::randomView(test::texturedImage(240, 180, 77), 320, 240, 78, 5), 14, 30)
+      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
+  const std::vector<cv::Rect> windows = {cv::Rect(0, 0, 320, 240), cv::Rect(320, 0, 320, 240)};
+  const RecognitionParams p;  // defaults: colour rescue on
+  ASSERT_TRUE(p.colour_rescue);
+  const FrameFeatures f = computeFrameFeatures(*model_, frame);
+  const auto per = recogniseWindows(*model_, f, windows, 3, p);
+  ASSERT_EQ(per.size(), 2u);
+  ASSERT_FALSE(per[0].empty());
+  ASSERT_FALSE(per[1].empty());
+  EXPECT_EQ(per[0][0].class_name, "red");
+  EXPECT_TRUE(per[0][0].verified);
+  EXPECT_EQ(per[1][0].class_name, "other");
+  EXPECT_TRUE(per[1][0].colour_rescued);
+  EXPECT_FALSE(per[1][0].rejected);
+  ASSERT_GT(per[1][0].votes, per[0][0].votes) << "the rescued class must lead by votes";
+  // Merged: by votes alone "other" would come first; the verified class does.
+  const auto all = recognise(*model_, f, windows, 3, p);
+  ASSERT_GE(all.size(), 2u);
+  EXPECT_EQ(all[0].class_name, "red");
+  EXPECT_TRUE(all[0].verified);
+  EXPECT_EQ(all[1].class_name, "other");
+  EXPECT_FALSE(all[1].rejected);
+}
