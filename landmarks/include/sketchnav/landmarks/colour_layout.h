@@ -27,7 +27,13 @@
 // pass a ratio test between classes), and database photos have no votes to train on the same
 // region. In a camera frame where the landmark is small, the whole frame's keypoint box is
 // mostly background: the colour evidence is then as weak as the BoW histogram's, and the
-// objectness windows or the fovea crop (nav) are what localise the landmark.
+// objectness windows or the fovea crop (nav) are what localise the landmark. Measured with
+// the colour rescue (recognition.h): photos letterboxed into 640×480 frames gain as much as
+// the photos themselves (top-1 0.58 -> 0.66 vs 0.65 -> 0.72), 10 objectness windows 0.65 ->
+// 0.75.
+//
+// Cost: ~0.23 ms per 640×480 frame for the thumbnail (in computeFrameFeatures), ~0.02 ms per
+// window for region, descriptor and classifier (one OpenCV thread).
 #include <opencv2/core.hpp>
 
 #include <vector>
