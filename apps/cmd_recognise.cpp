@@ -132,6 +132,8 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
                            {"votes", r.votes},
                            {"vote_share", r.vote_share},
                            {"bow_probability", r.bow_probability},
+                           {"colour_probability", r.colour_probability},
+                           {"colour_rescued", r.colour_rescued},
                            {"evidence", r.evidence},
                            {"rejected", r.rejected}});
         *runner.details << Json{{"image", path},
@@ -294,6 +296,8 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
                        {"evidence", r.evidence},
                        {"votes", r.votes},
                        {"bow_probability", r.bow_probability},
+                       {"colour_probability", r.colour_probability},
+                       {"colour_rescued", r.colour_rescued},
                        {"rejected", r.rejected},
                        {"window", {r.window.x, r.window.y, r.window.width, r.window.height}}});
     const bool rejected = res.empty() || res.front().rejected;
@@ -304,8 +308,12 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (!g.json) {
       std::cout << path << ": " << (rejected ? "none of these" : res.front().class_name) << "\n";
       for (const auto& r : res)
-        std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f%s\n", r.class_name.c_str(),
-                    r.score, r.inliers, r.bow_probability, r.rejected ? "  (not verified)" : "");
+        std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f  colour p %.3f%s\n",
+                    r.class_name.c_str(), r.score, r.inliers, r.bow_probability,
+                    r.colour_probability,
+                    r.rejected         ? "  (not verified)"
+                    : r.colour_rescued ? "  (not verified; votes and colour agree)"
+                                       : "");
     }
   }
   if (g.json) printJson({{"results", out}, {"unreadable", unreadable}, {"mode", modeJson(runner)}});

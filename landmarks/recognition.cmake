@@ -2,6 +2,7 @@
 # landmark set, model file, matcher, recognition.
 set(LANDMARKS_RECOGNITION_SOURCES
   ${CMAKE_CURRENT_SOURCE_DIR}/src/rootsift_features.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/colour_layout.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/vocab_vocabulary.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/bow_classifier.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/landmark_set_scan.cpp
@@ -13,4 +14,5 @@ set(LANDMARKS_RECOGNITION_TESTS
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_rootsift.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_model.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_match.cpp
-  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_grocery.cpp)
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_grocery.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_colour.cpp)

@@ -2,24 +2,31 @@
 """Fits recognise()'s combined score and tabulates accept_score (see calibrate.sh).
 
 Input: `sketchnav recognise --eval DIR --details FILE` lines (candidates with inliers, votes,
-vote_share, bow_probability, verified). Logistic regression over the candidates of known images
-(label: the candidate is the true class), features as in RecognitionParams::combinedScore():
-ln(1+inliers), vote share, ln(1+votes), SVM probability, verified. Plain Python (no numpy).
+vote_share, bow_probability, verified, colour_probability). Logistic regression over the
+candidates of known images (label: the candidate is the true class), features as in
+RecognitionParams::combinedScore(): ln(1+inliers), vote share, ln(1+votes), SVM probability,
+verified, colour-layout probability. Plain Python (no numpy).
 
-Usage: fit_score.py FIT.jsonl [EVAL.jsonl ...]  -- fits on the first, evaluates on all.
-       fit_score.py --weights b,i,s,v,p,ver FILE.jsonl ...  -- evaluates given weights.
+Usage: fit_score.py [--no-colour] FIT.jsonl [EVAL.jsonl ...]  -- fits on the first, evaluates
+                                                                on all (--no-colour: without
+                                                                the colour feature).
+       fit_score.py --weights b,i,s,v,p,ver[,col] FILE.jsonl ...  -- evaluates given weights.
 """
 import json
 import math
 import sys
 
 NAMES = ["score_bias", "score_inliers", "score_vote_share", "score_votes", "score_bow",
-         "score_verified"]
+         "score_verified", "score_colour"]
+USE_COLOUR = True
 
 
 def features(c):
-    return [1.0, math.log1p(c["inliers"]), c["vote_share"], math.log1p(c["votes"]),
-            c["bow_probability"], 1.0 if c["verified"] else 0.0]
+    f = [1.0, math.log1p(c["inliers"]), c["vote_share"], math.log1p(c["votes"]),
+         c["bow_probability"], 1.0 if c["verified"] else 0.0]
+    if USE_COLOUR:
+        f.append(c.get("colour_probability", 0.0))
+    return f
 
 
 def load(path):
@@ -89,6 +96,13 @@ def table(rows, w, name):
     print("  old rule (first verified by votes): top-1 %.3f, false rejections %.3f, unknown rejected %s" %
           (old_ok / max(1, len(known)), old_frej / max(1, len(known)),
            "%.3f" % (old_rej / len(unknown)) if unknown else "-"))
+    # The pipeline's own answer as run (the default rule plus the colour rescue, or whatever
+    # --set chose): the first candidate when it is not rejected.
+    ran = lambda r: r["candidates"][0]["class"] if r["candidates"] and not r["candidates"][0]["rejected"] else None
+    print("  as run (first candidate unless rejected): top-1 %.3f, false rejections %.3f, unknown rejected %s" %
+          (sum(1 for r in known if ran(r) == r["class"]) / max(1, len(known)),
+           sum(1 for r in known if ran(r) is None) / max(1, len(known)),
+           "%.3f" % (sum(1 for r in unknown if ran(r) is None) / len(unknown)) if unknown else "-"))
     print("  accept_score | top-1 | false rejections | unknown rejected")
     for t in [-3, -2.5, -2, -1.5, -1, -0.5, 0, 0.5, 1, 1.5, 2, 3]:
         ok = sum(1 for (s, cls), r in dec if r["known"] and s >= t and cls == r["class"])
@@ -99,9 +113,14 @@ def table(rows, w, name):
 
 
 def main():
+    global USE_COLOUR
     args = sys.argv[1:]
+    if args and args[0] == "--no-colour":
+        USE_COLOUR = False
+        args = args[1:]
     if args and args[0] == "--weights":
         w = [float(v) for v in args[1].split(",")]
+        USE_COLOUR = len(w) > 6
         files = args[2:]
     else:
         files = args

@@ -3,7 +3,10 @@
 # val/, one JSON file per configuration plus summary.json and summary.md, so each part's
 # contribution shows in one run:
 #   rootsift         RootSIFT + BoW/SVM + NN votes + colour-checked geometric verification
-#                    (the product's defaults)
+#                    + colour rescue (the product's defaults)
+#   no_colour_rescue the same without the colour-layout rescue (colour_rescue=false): the
+#                    colour-layout evidence's contribution (also frame_*, windows_*,
+#                    rejection_*, demo_*)
 #   rootsift_bow     the same model, BoW + linear SVM only (the classic pipeline)
 #   sift, sift_bow   plain SIFT instead of RootSIFT
 #   no_colour        the product without the keypoint colour check (colour_tolerance 0)
@@ -18,8 +21,11 @@
 #   rejection        three classes left out of training: their val images must be rejected
 #   rejection_no_colour  the same without the colour check
 #   rejection_combined   the same with the combined score
+#   min16, min16_no_colour_rescue  min_inliers 16 (stricter verification), with and without the
+#                    colour rescue (also rejection_min16*): the top-1 / rejection trade-off
 #   demo             the product's 8-class demo set (share/landmarks) on all val photos in
-#                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected)
+#                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected);
+#                    demo_no_colour_rescue the same without the colour rescue
 #
 # Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
 # Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean, and per
@@ -39,6 +45,8 @@ EXCLUDED=Oatly-Oat-Milk,Yoggi-Vanilla-Yoghurt,Bravo-Orange-Juice
 FAST=$here/fast.json
 NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
 COMBINED="--set landmarks.recognition.combined_score=true"
+NO_RESCUE="--set landmarks.recognition.colour_rescue=false"
+MIN16="--set landmarks.recognition.min_inliers=16"
 mkdir -p "$OUT"
 
 PROBE=$(find "$DATA/val" -name '*.jpg' | sort | sed -n 1p)  # not head: SIGPIPE under pipefail
@@ -64,20 +72,29 @@ usable "$OUT/demo.slm" || "$BIN" --json train --landmarks "$root/share/landmarks
   > "$OUT/train_demo.json"
 
 evaluate rootsift rootsift
+evaluate no_colour_rescue rootsift $NO_RESCUE
+evaluate min16 rootsift $MIN16
+evaluate min16_no_colour_rescue rootsift $MIN16 $NO_RESCUE
 evaluate rootsift_bow rootsift --no-verify
 evaluate sift sift
 evaluate sift_bow sift --no-verify
 evaluate no_colour rootsift $NO_COLOUR
 evaluate windows rootsift --windows 10
+evaluate windows_no_colour_rescue rootsift --windows 10 $NO_RESCUE
 evaluate frame rootsift --frame 640x480 --match
+evaluate frame_no_colour_rescue rootsift --frame 640x480 --match $NO_RESCUE
 evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
 evaluate combined rootsift $COMBINED
 evaluate synth synth
 evaluate synth_frame synth --frame 640x480 --match
 evaluate rejection rootsift_excluded
+evaluate rejection_no_colour_rescue rootsift_excluded $NO_RESCUE
+evaluate rejection_min16 rootsift_excluded $MIN16
+evaluate rejection_min16_no_colour_rescue rootsift_excluded $MIN16 $NO_RESCUE
 evaluate rejection_no_colour rootsift_excluded $NO_COLOUR
 evaluate rejection_combined rootsift_excluded $COMBINED
 evaluate demo demo --frame 640x480 --match
+evaluate demo_no_colour_rescue demo --frame 640x480 --match $NO_RESCUE
 
 python3 - "$OUT" <<'PY'
 import json, os, sys

@@ -9,6 +9,7 @@
 #include "matcher_internal.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/bow.h"
+#include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/matcher.h"
 
 namespace sketchnav::landmarks {
@@ -31,6 +32,7 @@ FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bg
   FrameFeatures f;
   f.features = extractFeatures(bgr, model.params().frameFeatures());
   f.words = model.vocabulary().assign(f.features.descriptors);
+  if (bgr.channels() >= 3) f.colour_thumbnail = colourThumbnail(bgr);
   return f;
 }
 
@@ -41,6 +43,7 @@ FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bg
   FrameFeatures f;
   f.features = extractFeatures(bgr, frame_params);
   f.words = model.vocabulary().assign(f.features.descriptors);
+  if (bgr.channels() >= 3) f.colour_thumbnail = colourThumbnail(bgr);  // ~0.2 ms at 640x480
   return f;
 }
 

@@ -3,7 +3,8 @@
 // File layout (little-endian, as written by this build):
 //   magic "SKNVLMDL" (8 bytes) | u32 format version | u64 payload size | u64 FNV-1a(payload)
 //   payload: params JSON, landmark set fingerprint, class names, vocabulary centres + IDF,
-//            classifier weights + rho + Platt (a, b), then per photo: class, path, size,
+//            classifier weights + rho + Platt (a, b), colour-layout classifier weights + rho +
+//            Platt (a, b) (since version 4), then per photo: class, path, size,
 //            keypoints (x, y, size, angle, response, octave), raw SIFT (N x 128 u8),
 //            keypoint colours (N x 3 u8, since version 3), words.
 // Working descriptors (RootSIFT) and histograms are recomputed on load: they are derived.
@@ -22,6 +23,7 @@
 
 #include "model_internal.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/model.h"
 
 namespace sketchnav::landmarks {
@@ -245,6 +247,10 @@ void LandmarkModel::save(const std::string& path) const {
   w.mat(cv::Mat(classifier_.rho, true).reshape(1, 1));
   w.put<float>(classifier_.platt_a);
   w.put<float>(classifier_.platt_b);
+  w.mat(colour_classifier_.weights);
+  w.mat(cv::Mat(colour_classifier_.rho, true).reshape(1, 1));
+  w.put<float>(colour_classifier_.platt_a);
+  w.put<float>(colour_classifier_.platt_b);
   w.put<std::uint32_t>(static_cast<std::uint32_t>(photos_.size()));
   for (const auto& ph : photos_) {
     w.put<std::int32_t>(ph.class_id);
@@ -339,6 +345,16 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
   if (m.classifier_.weights.rows != static_cast<int>(n_classes) ||
       m.classifier_.weights.cols != centres.rows || rho.total() != n_classes)
     r.corrupt("classifier");
+  m.colour_classifier_.weights = r.mat();
+  cv::Mat colour_rho = r.mat();
+  if (m.colour_classifier_.weights.type() != CV_32F ||
+      m.colour_classifier_.weights.rows != static_cast<int>(n_classes) ||
+      m.colour_classifier_.weights.cols != kColourLayoutDims || colour_rho.total() != n_classes ||
+      colour_rho.type() != CV_32F)
+    r.corrupt("colour classifier");
+  m.colour_classifier_.rho.assign(colour_rho.begin<float>(), colour_rho.end<float>());
+  m.colour_classifier_.platt_a = r.get<float>();
+  m.colour_classifier_.platt_b = r.get<float>();
   const auto n_photos = r.get<std::uint32_t>();
   m.photos_.resize(n_photos);
   for (auto& ph : m.photos_) {

@@ -10,6 +10,7 @@
 #include "model_internal.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/model.h"
 
@@ -113,6 +114,7 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
 
   // Features of every photo (the slow part: report progress).
   std::vector<DatabasePhoto> photos;
+  std::vector<cv::Mat> colour_layouts;  // per kept photo, colour_layout.h
   const int total = static_cast<int>(items.size());
   int skipped = 0;
   for (int i = 0; i < total; ++i) {
@@ -140,6 +142,13 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
                 {{"file", items[i].path}, {"features", std::to_string(ph.keypoints.size())}});
       ++skipped;
       continue;
+    }
+    {
+      std::vector<cv::Point2f> pts;
+      pts.reserve(ph.keypoints.size());
+      for (const auto& k : ph.keypoints) pts.push_back(k.pt);
+      colour_layouts.push_back(
+          colourLayoutDescriptor(colourThumbnail(img), img.size(), colourRegion(pts, img.size())));
     }
     photos.push_back(std::move(ph));
   }
@@ -198,6 +207,14 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
   }
   m.classifier_ = LinearClassifier::train(hists, labels, static_cast<int>(m.classes_.size()),
                                           params.svm_c, static_cast<unsigned>(params.seed));
+  // The same kind of classifier over the photos' colour layouts (same C: both inputs are unit
+  // L2 vectors).
+  cv::Mat colours(static_cast<int>(photos.size()), kColourLayoutDims, CV_32F);
+  for (size_t i = 0; i < photos.size(); ++i)
+    colour_layouts[i].copyTo(colours.row(static_cast<int>(i)));
+  m.colour_classifier_ =
+      LinearClassifier::train(colours, labels, static_cast<int>(m.classes_.size()), params.svm_c,
+                              static_cast<unsigned>(params.seed));
   if (progress) progress("classifier", 1, 1);
   m.vocabulary_ = std::move(vocab);
   m.photos_ = std::move(photos);

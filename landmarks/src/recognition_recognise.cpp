@@ -5,6 +5,7 @@
 #include <tuple>
 
 #include "matcher_internal.h"
+#include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/recognition.h"
 
 namespace sketchnav::landmarks {
@@ -19,14 +20,19 @@ void RecognitionParams::validate() const {
           "must be >= 0 (0 = no limit)");
   require(reject_probability >= 0 && reject_probability <= 1, "recognition.reject_probability",
           "must be in [0, 1]");
+  require(colour_rescue_rank >= 1, "recognition.colour_rescue_rank", "must be >= 1");
+  require(colour_rescue_probability >= 0 && colour_rescue_probability <= 1,
+          "recognition.colour_rescue_probability", "must be in [0, 1]");
+  require(colour_rescue_inliers >= 0, "recognition.colour_rescue_inliers", "must be >= 0");
   match.validate();
 }
 
 double RecognitionParams::combinedScore(int inliers, int votes, int total_votes, double bow_p,
-                                        bool verified) const {
+                                        bool verified, double colour_p) const {
   const double vote_share = total_votes > 0 ? static_cast<double>(votes) / total_votes : 0.0;
   return score_bias + score_inliers * std::log1p(inliers) + score_vote_share * vote_share +
-         score_votes * std::log1p(votes) + score_bow * bow_p + (verified ? score_verified : 0.0);
+         score_votes * std::log1p(votes) + score_bow * bow_p + (verified ? score_verified : 0.0) +
+         score_colour * colour_p;
 }
 
 namespace {
@@ -68,10 +74,26 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   std::iota(order.begin(), order.end(), 0);
   std::stable_sort(order.begin(), order.end(), [&](int a, int b) { return prob[a] > prob[b]; });
 
+  // Colour-layout evidence: one descriptor per window, over its keypoints' box (colour_layout.h
+  // says why that region), scored by every class's colour classifier.
+  std::vector<float> colour_p(n_classes, 0.0f);
+  if (!frame.colour_thumbnail.empty() && model.colourClassifier().classes() == n_classes) {
+    std::vector<cv::Point2f> pts;
+    pts.reserve(idx.size());
+    for (int i : idx) pts.push_back(frame.features.keypoints[i].pt);
+    const cv::Size size = frame.features.image_size;
+    colour_p = model.colourClassifier().probabilities(
+        colourLayoutDescriptor(frame.colour_thumbnail, size, colourRegion(pts, size, win)));
+  }
+  const int colour_best =
+      static_cast<int>(std::max_element(colour_p.begin(), colour_p.end()) - colour_p.begin());
+  const bool have_colour = !frame.colour_thumbnail.empty() && n_classes > 1;
+
   auto entry = [&](int c) {
     Recognition r;
     r.class_name = model.classes()[c];
     r.bow_probability = prob[c];
+    r.colour_probability = colour_p[c];
     r.score = prob[c];
     r.window = win;
     return r;
@@ -160,8 +182,8 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
   int total_votes = 0;
   for (int v : votes.class_votes) total_votes += v;
   auto evidence = [&](int c) {
-    return static_cast<float>(
-        p.combinedScore(ev[c].inliers, votes.class_votes[c], total_votes, prob[c], ev[c].verified));
+    return static_cast<float>(p.combinedScore(ev[c].inliers, votes.class_votes[c], total_votes,
+                                              prob[c], ev[c].verified, colour_p[c]));
   };
   auto make = [&](int c) {
     Recognition r = entry(c);
@@ -211,7 +233,23 @@ std::vector<Recognition> recogniseWindow(const LandmarkModel& model, const Frame
     out.push_back(make(c));
     used.insert(c);
   }
-  const bool none = verified.empty();
+  bool none = verified.empty();
+  // Colour rescue: no class verified, but one of the classes with most votes is also the colour
+  // classifier's confident first choice.
+  if (none && p.colour_rescue && have_colour && p.rank_by_votes) {
+    const int c = colour_best;
+    std::vector<int> by_votes = shortlist;  // sorted by votes (then BoW) above
+    by_votes.resize(std::min<size_t>(by_votes.size(), p.colour_rescue_rank));
+    if (std::find(by_votes.begin(), by_votes.end(), c) != by_votes.end() &&
+        votes.class_votes[c] > 0 && colour_p[c] >= p.colour_rescue_probability &&
+        ev[c].inliers >= p.colour_rescue_inliers) {
+      Recognition r = make(c);
+      r.colour_rescued = true;
+      out.push_back(r);
+      used.insert(c);
+      none = false;
+    }
+  }
   // The remaining candidates, unverified, in the ranking's order.
   std::vector<int> rest = order;
   if (p.rank_by_votes)
@@ -261,10 +299,13 @@ std::vector<Recognition> recognise(const LandmarkModel& model, const FrameFeatur
     all.insert(all.end(), v.begin(), v.end());
   // Best first: accepted before rejected, then the same order as within a window.
   auto key = [&](const Recognition& r) {
-    if (p.combined_score) return std::make_tuple(!r.rejected, r.evidence, 0, 0.0f);
-    return p.rank_by_votes
-               ? std::make_tuple(!r.rejected, static_cast<float>(r.votes), r.inliers, r.score)
-               : std::make_tuple(!r.rejected, static_cast<float>(r.inliers), r.votes, r.score);
+    // Verified before colour-rescued: a rescued class of one window must not displace a class
+    // another window verified.
+    if (p.combined_score) return std::make_tuple(!r.rejected, true, r.evidence, 0, 0.0f);
+    return p.rank_by_votes ? std::make_tuple(!r.rejected, !r.colour_rescued,
+                                             static_cast<float>(r.votes), r.inliers, r.score)
+                           : std::make_tuple(!r.rejected, !r.colour_rescued,
+                                             static_cast<float>(r.inliers), r.votes, r.score);
   };
   std::stable_sort(all.begin(), all.end(),
                    [&](const Recognition& a, const Recognition& b) { return key(a) > key(b); });

@@ -71,6 +71,7 @@ struct FrameFeatures {
   // window. Shared by copies; safe to use from several threads.
   struct PhotoCache;
   std::shared_ptr<PhotoCache> photo_cache = std::make_shared<PhotoCache>();
+  cv::Mat colour_thumbnail;  // colourThumbnail() of the frame (colour_layout.h); empty for grey
 };
 struct MatchResult;
 struct FrameFeatures::PhotoCache {

@@ -1,8 +1,9 @@
 #pragma once
-// The landmark model (.slm): vocabulary, BoW classifier and, per class, the keypoints,
-// descriptors and keypoint colours of its database photos for matching. Built by trainModel() from
-// a landmark set folder; saved as a versioned binary file (magic, format version, payload size,
-// FNV-1a checksum) so a truncated file or a file of another version is refused with a clear error.
+// The landmark model (.slm): vocabulary, BoW classifier, colour-layout classifier and, per class,
+// the keypoints, descriptors and keypoint colours of its database photos for matching. Built by
+// trainModel() from a landmark set folder; saved as a versioned binary file (magic, format version,
+// payload size, FNV-1a checksum) so a truncated file or a file of another version is refused with a
+// clear error.
 #include <opencv2/core.hpp>
 
 #include <functional>
@@ -77,9 +78,10 @@ struct DatabasePhoto {
 
 class LandmarkModel {
  public:
-  // 3: keypoint colours (opponent chromaticity) and frame_* params; 2 was a development format
-  // with another colour definition, refused so no model of it is used by mistake.
-  static constexpr std::uint32_t kFormatVersion = 3;
+  // 4: the colour-layout classifier (colourClassifier()). 3: keypoint colours (opponent
+  // chromaticity) and frame_* params; 2 was a development format with another colour
+  // definition. Older files are refused so no model without these parts is used by mistake.
+  static constexpr std::uint32_t kFormatVersion = 4;
 
   LandmarkModel();
   ~LandmarkModel();
@@ -91,6 +93,9 @@ class LandmarkModel {
   const ModelParams& params() const { return params_; }
   const Vocabulary& vocabulary() const { return vocabulary_; }
   const LinearClassifier& classifier() const { return classifier_; }
+  /// One-vs-rest linear classifier over the colour-layout descriptor (colour_layout.h) of each
+  /// database photo's keypoint region, Platt-calibrated like classifier().
+  const LinearClassifier& colourClassifier() const { return colour_classifier_; }
   const std::vector<DatabasePhoto>& photos() const { return photos_; }
   /// Indices into photos() of one class's database photos.
   const std::vector<int>& photosOfClass(int class_id) const { return by_class_[class_id]; }
@@ -133,6 +138,7 @@ class LandmarkModel {
   std::vector<std::string> classes_;
   Vocabulary vocabulary_;
   LinearClassifier classifier_;
+  LinearClassifier colour_classifier_;
   std::vector<DatabasePhoto> photos_;
   std::vector<std::vector<int>> by_class_;
   std::string fingerprint_;
