@@ -120,12 +120,13 @@ TEST(Executive, AvoidsAStaticObstacleOnThePath) {
 // A landmark of the last section out of the camera's view all the way (90 deg left of the
 // goal): the robot turns to it at the goal and looks before arriving.
 void lookBesideTheGoal(Scenario& s) {
-  s.route = makeRoute({{0, 0}, {6, 0}, {6, 5}}, {{0, "A", "cup", {7.0, 0.3}},
-                                                 {1, "B", "bin", {6.4, 6.2}},
-                                                 {1, "C", "box", {3.5, 5.3}}});
+  s.route = makeRoute(
+      {{0, 0}, {6, 0}, {6, 5}},
+      {{0, "A", "cup", {7.0, 0.3}}, {1, "B", "bin", {6.4, 6.2}}, {1, "C", "box", {3.5, 5.3}}});
   s.world.obstacles.push_back({{3.5, 5.0}, 0.15});
   s.perception = std::make_unique<GeometricPerception>(
-      s.world, std::vector<TrueMark>{{"cup", {7.3, 0.5}}, {"bin", {6.6, 6.5}}, {"box", {3.5, 5.0}}});
+      s.world,
+      std::vector<TrueMark>{{"cup", {7.3, 0.5}}, {"bin", {6.6, 6.5}}, {"box", {3.5, 5.0}}});
 }
 
 TEST(Executive, LooksForAnUnseenLastLandmarkAtTheGoal) {
@@ -142,6 +143,20 @@ TEST(Executive, LooksForAnUnseenLastLandmarkAtTheGoal) {
     }
   ASSERT_EQ(sum.landmarks.size(), 3u);
   EXPECT_EQ(sum.landmarks[2].state, "passed");
+}
+
+TEST(Executive, TheFinalLookDoesNotCountAsNoLongerGettingCloser) {
+  // Turning on the spot to look is not being stuck near the goal: with a settle time shorter
+  // than the look, the robot still goes on to the goal afterwards (an exp2-redrawn-d robot
+  // settled 0.21 m short of its goal estimate right after its final look).
+  Scenario s;
+  lookBesideTheGoal(s);
+  s.settings.exec.goal_settle_s = 1.5;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  ASSERT_EQ(s.rec.count("final_look_start"), 1);
+  EXPECT_EQ(s.rec.count("goal_settled"), 0);
+  EXPECT_EQ(sum.reason, "reached the end of the route");
 }
 
 TEST(Executive, WithoutTheFinalLookTheLastLandmarkIsMissed) {
