@@ -29,11 +29,7 @@ void MatchParams::validate() const {
 }
 
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr) {
-  FrameFeatures f;
-  f.features = extractFeatures(bgr, model.params().frameFeatures());
-  f.words = model.vocabulary().assign(f.features.descriptors);
-  if (bgr.channels() >= 3) f.colour_thumbnail = colourThumbnail(bgr);
-  return f;
+  return computeFrameFeatures(model, bgr, model.params().frameFeatures());
 }
 
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr,

@@ -15,6 +15,12 @@ using namespace sketchnav;
 using namespace sketchnav::nav;
 
 namespace {
+// Drive a pose ds along its heading, then turn it by dth (the simulated truth and wheels).
+void advance(hw::Pose2D& p, double ds, double dth) {
+  p.x += ds * std::cos(p.theta);
+  p.y += ds * std::sin(p.theta);
+  p.theta = wrapAngle(p.theta + dth);
+}
 struct Seg {
   double ax, ay, bx, by;
 };
@@ -93,13 +99,8 @@ Result drive(double drift, double seconds, bool with_laser, unsigned seed,
       leg += ds;
       if (leg >= len - 1e-9) turning = true, ++legs;
     }
-    truth.x += ds * std::cos(truth.theta);
-    truth.y += ds * std::sin(truth.theta);
-    truth.theta = wrapAngle(truth.theta + dth);
-    const double wdth = dth + drift * ds;
-    wheel.x += ds * std::cos(wheel.theta);
-    wheel.y += ds * std::sin(wheel.theta);
-    wheel.theta = wrapAngle(wheel.theta + wdth);
+    advance(truth, ds, dth);
+    advance(wheel, ds, dth + drift * ds);
     lo.wheel(wheel, t);
     if (with_laser && k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
   }
@@ -221,12 +222,8 @@ Result weave(unsigned seed, LaserOdometryParams p = {}) {
                      : t < 28 ? 0.15
                               : 0.0;
     const double ds = v * dt, dth = w * dt;
-    truth.x += ds * std::cos(truth.theta);
-    truth.y += ds * std::sin(truth.theta);
-    truth.theta = wrapAngle(truth.theta + dth);
-    wheel.x += ds * std::cos(wheel.theta);
-    wheel.y += ds * std::sin(wheel.theta);
-    wheel.theta = wrapAngle(wheel.theta + 1.06 * dth + 0.01 * ds);
+    advance(truth, ds, dth);
+    advance(wheel, ds, 1.06 * dth + 0.01 * ds);
     lo.wheel(wheel, t);
     if (k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
     worst = std::max(worst, std::abs(wrapAngle(lo.pose().theta - (truth.theta - start.theta))));
@@ -271,12 +268,8 @@ Result throughTheDoor(unsigned seed) {
     const double t = k * dt;
     const double w = truth.x > 6.6 && truth.theta < M_PI / 2 - 0.02 ? 0.3 : 0.0;
     const double ds = v * dt, dth = w * dt;
-    truth.x += ds * std::cos(truth.theta);
-    truth.y += ds * std::sin(truth.theta);
-    truth.theta = wrapAngle(truth.theta + dth);
-    wheel.x += ds * std::cos(wheel.theta);
-    wheel.y += ds * std::sin(wheel.theta);
-    wheel.theta = wrapAngle(wheel.theta + 1.06 * dth);
+    advance(truth, ds, dth);
+    advance(wheel, ds, 1.06 * dth);
     lo.wheel(wheel, t);
     if (k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
     if (truth.y > 8.0) break;
