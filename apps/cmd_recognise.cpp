@@ -134,6 +134,7 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
                            {"bow_probability", r.bow_probability},
                            {"colour_probability", r.colour_probability},
                            {"colour_rescued", r.colour_rescued},
+                           {"appearance", r.appearance},
                            {"evidence", r.evidence},
                            {"rejected", r.rejected}});
         *runner.details << Json{{"image", path},
@@ -298,6 +299,7 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
                        {"bow_probability", r.bow_probability},
                        {"colour_probability", r.colour_probability},
                        {"colour_rescued", r.colour_rescued},
+                       {"appearance", r.appearance},
                        {"rejected", r.rejected},
                        {"window", {r.window.x, r.window.y, r.window.width, r.window.height}}});
     const bool rejected = res.empty() || res.front().rejected;
@@ -311,9 +313,10 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
         std::printf("  %-40s score %.3f  inliers %3d  bow p %.3f  colour p %.3f%s\n",
                     r.class_name.c_str(), r.score, r.inliers, r.bow_probability,
                     r.colour_probability,
-                    r.rejected         ? "  (not verified)"
-                    : r.colour_rescued ? "  (not verified; votes and colour agree)"
-                                       : "");
+                    r.rejected && r.verified ? "  (verified; the sibling check chose another class)"
+                    : r.rejected             ? "  (not verified)"
+                    : r.colour_rescued       ? "  (not verified; votes and colour agree)"
+                                             : "");
     }
   }
   if (g.json) printJson({{"results", out}, {"unreadable", unreadable}, {"mode", modeJson(runner)}});

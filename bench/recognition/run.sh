@@ -3,7 +3,10 @@
 # val/, one JSON file per configuration plus summary.json and summary.md, so each part's
 # contribution shows in one run:
 #   rootsift         RootSIFT + BoW/SVM + NN votes + colour-checked geometric verification
-#                    + colour rescue (the product's defaults)
+#                    + colour rescue + sibling check (the product's defaults)
+#   no_sibling_check the same without the sibling check (sibling_check=false: the lazy
+#                    verification's first verified class by votes stands; also frame_*,
+#                    rejection_*)
 #   no_colour_rescue the same without the colour-layout rescue (colour_rescue=false): the
 #                    colour-layout evidence's contribution (also frame_*, windows_*,
 #                    rejection_*, demo_*)
@@ -47,6 +50,7 @@ NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
 COMBINED="--set landmarks.recognition.combined_score=true"
 NO_RESCUE="--set landmarks.recognition.colour_rescue=false"
 MIN16="--set landmarks.recognition.min_inliers=16"
+NO_SIBLING="--set landmarks.recognition.sibling_check=false"
 mkdir -p "$OUT"
 
 PROBE=$(find "$DATA/val" -name '*.jpg' | sort | sed -n 1p)  # not head: SIGPIPE under pipefail
@@ -72,6 +76,7 @@ usable "$OUT/demo.slm" || "$BIN" --json train --landmarks "$root/share/landmarks
   > "$OUT/train_demo.json"
 
 evaluate rootsift rootsift
+evaluate no_sibling_check rootsift $NO_SIBLING
 evaluate no_colour_rescue rootsift $NO_RESCUE
 evaluate min16 rootsift $MIN16
 evaluate min16_no_colour_rescue rootsift $MIN16 $NO_RESCUE
@@ -82,12 +87,14 @@ evaluate no_colour rootsift $NO_COLOUR
 evaluate windows rootsift --windows 10
 evaluate windows_no_colour_rescue rootsift --windows 10 $NO_RESCUE
 evaluate frame rootsift --frame 640x480 --match
+evaluate frame_no_sibling_check rootsift --frame 640x480 --match $NO_SIBLING
 evaluate frame_no_colour_rescue rootsift --frame 640x480 --match $NO_RESCUE
 evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
 evaluate combined rootsift $COMBINED
 evaluate synth synth
 evaluate synth_frame synth --frame 640x480 --match
 evaluate rejection rootsift_excluded
+evaluate rejection_no_sibling_check rootsift_excluded $NO_SIBLING
 evaluate rejection_no_colour_rescue rootsift_excluded $NO_RESCUE
 evaluate rejection_min16 rootsift_excluded $MIN16
 evaluate rejection_min16_no_colour_rescue rootsift_excluded $MIN16 $NO_RESCUE

@@ -6,7 +6,8 @@
 //            classifier weights + rho + Platt (a, b), colour-layout classifier weights + rho +
 //            Platt (a, b) (since version 4), then per photo: class, path, size,
 //            keypoints (x, y, size, angle, response, octave), raw SIFT (N x 128 u8),
-//            keypoint colours (N x 3 u8, since version 3), words.
+//            keypoint colours (N x 3 u8, since version 3), words, colour thumbnail (H x 3W u8,
+//            since version 5).
 // Working descriptors (RootSIFT) and histograms are recomputed on load: they are derived.
 #include <opencv2/flann.hpp>
 // After flann.hpp, which it needs (cvflann::seed_random).
@@ -269,6 +270,7 @@ void LandmarkModel::save(const std::string& path) const {
     w.mat(ph.sift_u8.empty() ? cv::Mat(0, 128, CV_8U) : ph.sift_u8);
     w.mat(ph.colours.empty() ? cv::Mat(0, 3, CV_8U) : ph.colours);
     w.mat(cv::Mat(ph.words, true).reshape(1, 1));
+    w.mat(ph.thumbnail.empty() ? cv::Mat(0, 0, CV_8U) : ph.thumbnail.reshape(1));
   }
   const std::string& payload = w.buffer();
   // Written beside the target and renamed into place, so a reader (another process sharing the
@@ -382,6 +384,11 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
     ph.words.assign(words.begin<int>(), words.end<int>());
     for (int wd : ph.words)
       if (wd < 0 || wd >= centres.rows) r.corrupt("word index");
+    cv::Mat thumb = r.mat();
+    if (thumb.type() != CV_8U || thumb.cols % 3 != 0 || thumb.rows > kPhotoThumbnailSide ||
+        thumb.cols > 3 * kPhotoThumbnailSide)
+      r.corrupt("photo thumbnail");
+    if (!thumb.empty()) ph.thumbnail = thumb.reshape(3);
   }
   if (!r.atEnd()) r.corrupt("trailing bytes");
   m.finalise();

@@ -233,7 +233,7 @@ TEST_F(TwinModel, ColourClassifierSurvivesTheRoundTripAndOlderVersionsAreRefused
   for (size_t i = 0; i < ra.size(); ++i)
     EXPECT_EQ(ra[i].colour_probability, rb[i].colour_probability);
   // A version-3 file (no colour classifier) is refused with the version named.
-  ASSERT_EQ(LandmarkModel::kFormatVersion, 4u);
+  ASSERT_GE(LandmarkModel::kFormatVersion, 4u);
   std::ifstream in(dir + "/m.slm", std::ios::binary);
   std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
   data[8] = 3;
@@ -243,7 +243,10 @@ TEST_F(TwinModel, ColourClassifierSurvivesTheRoundTripAndOlderVersionsAreRefused
     FAIL() << "a version 3 model was accepted";
   } catch (const InputError& e) {
     const std::string msg = e.what();
-    EXPECT_NE(msg.find("version 3, this build reads version 4"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("version 3, this build reads version " +
+                       std::to_string(LandmarkModel::kFormatVersion)),
+              std::string::npos)
+        << msg;
     EXPECT_NE(msg.find("retrain"), std::string::npos) << msg;
   }
 }

@@ -318,6 +318,39 @@ TEST_F(TinyModel, AnOlderFormatIsRefusedAndACachedOneRetrained) {
   EXPECT_NO_THROW(LandmarkModel::load(dir + "/v1.slm")) << "the cache was rewritten";
 }
 
+TEST_F(TinyModel, PhotoThumbnailsRoundTripAndAFormat4FileIsRefused) {
+  // Version 5 added a colour thumbnail per photo (the sibling check): stored, read back
+  // pixel for pixel, and a version-4 file (no thumbnails) is refused with the retrain hint.
+  ASSERT_EQ(LandmarkModel::kFormatVersion, 5u);
+  const std::string dir = test::tempDir("recog-thumbs");
+  model_->save(dir + "/m.slm");
+  const LandmarkModel m = LandmarkModel::load(dir + "/m.slm");
+  ASSERT_EQ(m.photos().size(), model_->photos().size());
+  for (size_t i = 0; i < m.photos().size(); ++i) {
+    const cv::Mat& a = model_->photos()[i].thumbnail;
+    const cv::Mat& b = m.photos()[i].thumbnail;
+    ASSERT_FALSE(a.empty()) << i;
+    EXPECT_EQ(a.type(), CV_8UC3);
+    EXPECT_EQ(std::max(a.cols, a.rows), kPhotoThumbnailSide) << "320 x 240 photos are shrunk";
+    ASSERT_EQ(a.size(), b.size()) << i;
+    ASSERT_EQ(b.type(), CV_8UC3);
+    EXPECT_EQ(cv::norm(a, b, cv::NORM_INF), 0) << i;
+  }
+  std::string data = readAll(dir + "/m.slm");
+  data[8] = 4;
+  data[9] = data[10] = data[11] = 0;
+  writeAll(dir + "/v4.slm", data);
+  try {
+    LandmarkModel::load(dir + "/v4.slm");
+    FAIL() << "a version 4 model was accepted";
+  } catch (const InputError& e) {
+    const std::string msg = e.what();
+    EXPECT_NE(msg.find("version 4"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("retrain"), std::string::npos) << msg;
+    EXPECT_NE(msg.find("v4.slm"), std::string::npos) << msg;
+  }
+}
+
 TEST_F(TinyModel, KeypointColoursAreStoredPerDatabaseKeypoint) {
   for (const auto& ph : model_->photos()) {
     ASSERT_EQ(ph.colours.rows, static_cast<int>(ph.keypoints.size())) << ph.path;

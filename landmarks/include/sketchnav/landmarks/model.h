@@ -74,14 +74,23 @@ struct DatabasePhoto {
   cv::Mat descriptors;  // N x 128 CV_32F working descriptors (RootSIFT or SIFT), built on load
   std::vector<int> words;
   cv::Mat histogram;  // 1 x K BoW histogram, built on load
+  // The photo shrunk (INTER_AREA) to at most kPhotoThumbnailSide px on its longer side, BGR
+  // CV_8UC3 (format 5): recognise() warps it into the frame to compare sibling candidates'
+  // appearance densely (RecognitionParams::sibling_check). 12 KB per photo (64 px: the same val
+  // result as 96 px in the prototype, /work/notes/s7).
+  cv::Mat thumbnail;
 };
+
+/// [px] longer side of DatabasePhoto::thumbnail.
+constexpr int kPhotoThumbnailSide = 64;
 
 class LandmarkModel {
  public:
-  // 4: the colour-layout classifier (colourClassifier()). 3: keypoint colours (opponent
+  // 5: a colour thumbnail per photo (DatabasePhoto::thumbnail). 4: the colour-layout
+  // classifier (colourClassifier()). 3: keypoint colours (opponent
   // chromaticity) and frame_* params; 2 was a development format with another colour
   // definition. Older files are refused so no model without these parts is used by mistake.
-  static constexpr std::uint32_t kFormatVersion = 4;
+  static constexpr std::uint32_t kFormatVersion = 5;
 
   LandmarkModel();
   ~LandmarkModel();
