@@ -374,6 +374,7 @@ Json runNavigation(const RunOptions& o) {
     if (!o.config.has("nav.camera_period_s") && simr->params().camera_hz > 0)
       settings.exec.camera_period_s = 1.0 / simr->params().camera_hz;
     pp.camera_yaw = w.camera.yaw;
+    pp.camera_pitch = w.camera.pitch;
   }
   if (o.max_time_s > 0) settings.exec.max_time_s = o.max_time_s;
   settings.exec.validate();

@@ -542,8 +542,12 @@ struct Executive::Impl {
         const bool far = range > fixRange();
         if (!far || s.exec.fit_bearing_only) {
           if (t.sightings.size() >= 80) t.sightings.erase(t.sightings.begin());
-          t.sightings.push_back(
-              {{pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0});
+          Sighting sg{
+              {pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0};
+          sg.elevation = d.elevation;
+          sg.camera_along_m = s.servo.camera_x_m * std::cos(d.bearing);
+          sg.photo = d.photo;
+          t.sightings.push_back(sg);
         }
         if (n == 0) {
           const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
@@ -1028,6 +1032,8 @@ struct Executive::Impl {
       e["fix_method"] = lf.bearing_only ? "bearing only" : lf.triangulated ? "bearings" : "ranges";
       e["fix_rays"] = lf.rays;
       e["fix_ranges_used"] = lf.ranges_used;
+      e["fix_height_ranges"] = lf.height_ranges;
+      if (lf.height_ranges > 0) e["fix_height_sigma_m"] = lf.height_sigma_m;
       e["fix_ranges_dropped"] = lf.ranges_dropped;
       json rays = json::array();
       for (const auto& q : tr.sightings)

@@ -80,6 +80,24 @@ landmarks::MatchParams matchParams(const PerceptionParams& P) {
   return mp;
 }
 
+// Elevation [rad] above the camera's horizontal plane of the matched object's centre (the
+// database photo's centre through H), the camera tilted up by `pitch`; NaN without a usable H.
+double elevationOf(const landmarks::MatchResult& m, const hw::Intrinsics& K, double pitch) {
+  if (m.H.empty()) return NAN;
+  const cv::Mat& H = m.H;
+  const double dcx = 0.5 * m.database_size.width, dcy = 0.5 * m.database_size.height;
+  const double w = H.at<double>(2, 0) * dcx + H.at<double>(2, 1) * dcy + H.at<double>(2, 2);
+  if (std::abs(w) < 1e-9) return NAN;
+  const double u = (H.at<double>(0, 0) * dcx + H.at<double>(0, 1) * dcy + H.at<double>(0, 2)) / w;
+  const double v = (H.at<double>(1, 0) * dcx + H.at<double>(1, 1) * dcy + H.at<double>(1, 2)) / w;
+  if (!std::isfinite(u) || !std::isfinite(v) || v < -K.height || v > 2.0 * K.height) return NAN;
+  // The ray (x, y, 1) in the optical frame (y down), in the robot's frame (x ahead, z up).
+  const double x = (u - K.cx) / K.fx, y = (v - K.cy) / K.fy;
+  const double ahead = std::cos(pitch) + y * std::sin(pitch);
+  const double up = std::sin(pitch) - y * std::cos(pitch);
+  return std::atan2(up, std::hypot(ahead, x));
+}
+
 // A match (in frame pixels) as a Detection; false when it gives no servo offset.
 bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const cv::Rect& window,
                  int frame_cols, const hw::Intrinsics& K, const PerceptionParams& P, Detection& d) {
@@ -95,6 +113,8 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   const double err_px = P.paper_offset ? off.paper_offset_px : off.offset_px;
   d.x_d = d.x_t - err_px / K.fx;
   d.bearing = P.camera_yaw - std::atan(d.x_t);
+  d.photo = m.database_photo;
+  d.elevation = elevationOf(m, K, P.camera_pitch);
   return true;
 }
 }  // namespace

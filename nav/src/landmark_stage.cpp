@@ -4,6 +4,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <map>
+#include <utility>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/nav/sections.h"
@@ -53,11 +55,141 @@ void LocateParams::validate() const {
   require(max_along_sigma_m > 0, "nav.locate.max_along_sigma_m", "must be > 0");
   require(range_sigma_m > 0, "nav.locate.range_sigma_m", "must be > 0");
   require(range_gate_m > 0, "nav.locate.range_gate_m", "must be > 0");
+  require(height_min_sightings >= 3, "nav.locate.height_min_sightings", "must be >= 3");
+  require(height_min_elevation_deg > 0 && height_min_elevation_deg < 80,
+          "nav.locate.height_min_elevation_deg", "must be in (0, 80)");
+  require(height_elevation_sigma_deg > 0 && height_elevation_sigma_deg < 10,
+          "nav.locate.height_elevation_sigma_deg", "must be in (0, 10)");
+  require(height_max_sigma_m > 0, "nav.locate.height_max_sigma_m", "must be > 0");
+  require(height_min_sigma_m > 0, "nav.locate.height_min_sigma_m", "must be > 0");
+  require(height_agree_m > 0, "nav.locate.height_agree_m", "must be > 0");
 }
 
-LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& p) {
+HeightRanges heightRanges(const std::vector<Sighting>& ss, const LocateParams& p) {
+  HeightRanges out;
+  if (!p.height_ranging) return out;
+  const double emin = p.height_min_elevation_deg * M_PI / 180;
+  std::map<int, std::vector<int>> by_photo;
+  for (size_t i = 0; i < ss.size(); ++i)
+    if (std::isfinite(ss[i].elevation) && std::abs(ss[i].elevation) >= emin)
+      by_photo[ss[i].photo].push_back(static_cast<int>(i));
+  std::vector<std::vector<int>> groups;
+  for (auto& [photo, idx] : by_photo)
+    if (static_cast<int>(idx.size()) >= p.height_min_sightings) groups.push_back(idx);
+  if (groups.empty()) return out;
+  // Unknowns: the landmark point q (2) and one height difference per photo. Sighting i says
+  // q = o_i + (camera_along_i + dh_g cot e_i) u_i. Weighted least squares: along its ray a
+  // sighting is worth (r^2 / dh) x elevation noise, across it r x bearing noise, so the far
+  // ones (small elevations, noisy cotangents that would pull dh towards 0) count little. The
+  // weights need r and dh: a first pass with equal weights gives them.
+  const int G = static_cast<int>(groups.size()), n_par = 2 + G;
+  const double sigma = p.bearing_sigma_deg * M_PI / 180;
+  const double sigma_e = p.height_elevation_sigma_deg * M_PI / 180;
+  auto unit = [](double a) { return Eigen::Vector2d(std::cos(a), std::sin(a)); };
+  Eigen::MatrixXd AtA;
+  Eigen::VectorXd x = Eigen::VectorXd::Zero(n_par);
+  double sse = 0;
+  int rows = 0;
+  // A sighting's noise [m] along and across its ray at the current estimate x.
+  auto noise = [&](int g, const Sighting& s) {
+    const double dh = std::abs(x(2 + g)) + 0.05;
+    const double r = std::max(0.5, (x.head<2>() - s.origin).norm());
+    return std::pair(r * r / dh * sigma_e + 0.02, r * sigma + 0.02);
+  };
+  for (int pass = 0; pass < 2; ++pass) {
+    AtA = Eigen::MatrixXd::Zero(n_par, n_par);
+    Eigen::VectorXd Atb = Eigen::VectorXd::Zero(n_par);
+    rows = 0;
+    for (int g = 0; g < G; ++g)
+      for (int i : groups[g]) {
+        const Sighting& s = ss[i];
+        const Eigen::Vector2d u = unit(s.direction), nn(-u.y(), u.x());
+        const Eigen::Vector2d a = u / std::tan(s.elevation);
+        const Eigen::Vector2d o = s.origin + s.camera_along_m * u;
+        Eigen::Matrix2d W = Eigen::Matrix2d::Identity();
+        if (pass == 1) {
+          const auto [s_along, s_across] = noise(g, s);
+          W = u * u.transpose() / (s_along * s_along) + nn * nn.transpose() / (s_across * s_across);
+        }
+        Eigen::MatrixXd J = Eigen::MatrixXd::Zero(2, n_par);  // q - dh_g a = o
+        J(0, 0) = 1, J(1, 1) = 1;
+        J.col(2 + g) = -a;
+        AtA += J.transpose() * W * J;
+        Atb += J.transpose() * W * o;
+        rows += 2;
+      }
+    if (rows <= n_par) return out;
+    AtA += 1e-9 * Eigen::MatrixXd::Identity(n_par, n_par);
+    x = AtA.ldlt().solve(Atb);
+  }
+  // Weighted residuals: their scale says how far the assumed noise is off.
+  for (int g = 0; g < G; ++g)
+    for (int i : groups[g]) {
+      const Sighting& s = ss[i];
+      const Eigen::Vector2d u = unit(s.direction), nn(-u.y(), u.x());
+      const Eigen::Vector2d res =
+          x.head<2>() - s.origin - (s.camera_along_m + x(2 + g) / std::tan(s.elevation)) * u;
+      const auto [s_along, s_across] = noise(g, s);
+      sse += std::pow(u.dot(res) / s_along, 2) + std::pow(nn.dot(res) / s_across, 2);
+    }
+  // At least the assumed noise: a perfect fit (simulation) must not claim perfect ranges.
+  const double s2 = std::max(sse / (rows - n_par), 1.0);
+  const Eigen::MatrixXd cov = s2 * AtA.inverse();
+  out.range_m.assign(ss.size(), 0.0);
+  out.sigma_m = 1e300;
+  bool any = false;
+  for (int g = 0; g < G; ++g) {
+    const double dh = x(2 + g), sd = std::sqrt(std::max(0.0, cov(2 + g, 2 + g)));
+    for (int i : groups[g]) {
+      const Sighting& s = ss[i];
+      const double cot = 1 / std::tan(s.elevation);
+      const double r = s.camera_along_m + dh * cot, sr = sd * std::abs(cot);
+      // A negative range is the wrong root (the fit found no height, only noise).
+      if (r <= 0.3 || sr > p.height_max_sigma_m) continue;
+      out.range_m[i] = r;
+      out.sigma_m = std::min(out.sigma_m, sr);
+      any = true;
+    }
+  }
+  if (!any) return {};
+  out.sigma_m = std::max(out.sigma_m, p.height_min_sigma_m);
+  return out;
+}
+
+LandmarkFix locateLandmark(const std::vector<Sighting>& sightings, const LocateParams& p) {
   LandmarkFix f;
-  if (ss.empty()) return f;
+  if (sightings.empty()) return f;
+  // Height ranges in place of laser ranges that disagree with them (the laser hit what stands
+  // behind or below the landmark), and for sightings the laser did not range at all.
+  std::vector<double> range_sigma(sightings.size(), p.range_sigma_m);
+  std::vector<Sighting> hs;
+  const HeightRanges hr = heightRanges(sightings, p);
+  if (!hr.range_m.empty()) {
+    std::vector<double> diff;
+    for (size_t i = 0; i < sightings.size(); ++i)
+      if (hr.range_m[i] > 0 && sightings[i].range_m > 0)
+        diff.push_back(sightings[i].range_m - hr.range_m[i]);
+    bool laser_agrees = false;
+    if (!diff.empty()) {
+      std::nth_element(diff.begin(), diff.begin() + diff.size() / 2, diff.end());
+      laser_agrees = std::abs(diff[diff.size() / 2]) <= p.height_agree_m;
+    }
+    hs = sightings;
+    for (size_t i = 0; i < hs.size(); ++i) {
+      if (laser_agrees && hs[i].range_m > 0) continue;
+      if (hr.range_m[i] > 0) {
+        hs[i].range_m = hr.range_m[i];
+        hs[i].beyond_m = 0;
+        range_sigma[i] = hr.sigma_m;
+        ++f.height_ranges;
+      } else if (!laser_agrees && hs[i].range_m > 0) {
+        hs[i].beyond_m = hs[i].range_m;  // the landmark is no further, that is all
+        hs[i].range_m = 0;
+      }
+    }
+    f.height_sigma_m = f.height_ranges > 0 ? hr.sigma_m : 0;
+  }
+  const std::vector<Sighting>& ss = hs.empty() ? sightings : hs;
   const double sb = p.bearing_sigma_deg * M_PI / 180;
   auto unit = [](double a) { return Eigen::Vector2d(std::cos(a), std::sin(a)); };
   // Distance of a sighting for its bearing's weight: the range, the reading beyond, or 3 m.
@@ -125,23 +257,25 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& ss, const LocateParams& 
     std::nth_element(ys.begin(), ys.begin() + ys.size() / 2, ys.end());
     ref = {xs[xs.size() / 2], ys[ys.size() / 2]};
   }
-  std::vector<const Sighting*> agree;
-  for (const auto& s : ss) {
+  std::vector<size_t> agree;
+  for (size_t i = 0; i < ss.size(); ++i) {
+    const Sighting& s = ss[i];
     if (s.range_m <= 0) continue;
     const Eigen::Vector2d u = unit(s.direction);
     const double slack = f.triangulated ? 2 * std::sqrt(std::max(0.0, u.dot(Cb * u))) : 0.0;
     if (std::abs(u.dot(ref - s.origin) - s.range_m) > p.range_gate_m + slack)
       ++f.ranges_dropped;
     else
-      agree.push_back(&s);
+      agree.push_back(i);
   }
-  // The ranges' error is mostly one bias shared by all of them (the same furniture behind),
-  // so together they are worth range_sigma_m, not range_sigma_m / sqrt(n).
+  // The ranges' error is mostly one bias shared by all of them (the same furniture behind; one
+  // height fit), so together they are worth one range's sigma, not sigma / sqrt(n).
   f.ranges_used = static_cast<int>(agree.size());
-  for (const Sighting* s : agree) {
-    const Eigen::Vector2d u = unit(s->direction);
-    const double wr = 1.0 / (agree.size() * p.range_sigma_m * p.range_sigma_m);
-    I += wr * u * u.transpose(), b += wr * (u.dot(s->origin) + s->range_m) * u;
+  for (size_t i : agree) {
+    const Sighting& s = ss[i];
+    const Eigen::Vector2d u = unit(s.direction);
+    const double wr = 1.0 / (agree.size() * range_sigma[i] * range_sigma[i]);
+    I += wr * u * u.transpose(), b += wr * (u.dot(s.origin) + s.range_m) * u;
   }
   if (!f.triangulated && f.ranges_used == 0) return bearingOnly();
   f.ok = true;

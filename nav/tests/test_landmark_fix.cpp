@@ -109,12 +109,113 @@ TEST(LocateLandmark, OneStrayRangeDoesNotMoveARangesOnlyFix) {
   EXPECT_NEAR(f.position.x(), 6.0, 1e-6);
 }
 
+// The robot heads for a landmark whose centre stands dh above the camera (the camera
+// `camera_along` ahead of the origin), from x0 to x1 in n sightings: bearings and elevations
+// with Gaussian noise of sigma_deg, laser ranges `range_bias` long (<= -1: none), the
+// database photo alternating between `photos` of them whose centres sit dh_step apart in
+// height (each photo frames the object differently).
+std::vector<Sighting> approach(const Eigen::Vector2d& lm, double x0, double x1, int n,
+                               double sigma_deg, double dh, double range_bias, int photos = 1,
+                               double dh_step = 0.0, std::uint32_t seed = 5) {
+  const double camera_along = 0.13;
+  std::mt19937 rng(seed);
+  std::normal_distribution<double> nb(0.0, sigma_deg * M_PI / 180);
+  std::vector<Sighting> ss;
+  for (int i = 0; i < n; ++i) {
+    const Eigen::Vector2d o(x0 + (x1 - x0) * i / std::max(1, n - 1), 0.0);
+    const Eigen::Vector2d d = lm - o;
+    const double a = std::atan2(d.y(), d.x());
+    Sighting s{o, a + nb(rng), range_bias <= -1 ? 0.0 : d.norm() + range_bias};
+    const int photo = i % photos;
+    s.photo = photo;
+    s.camera_along_m = camera_along * std::cos(a);
+    s.elevation = std::atan2(dh + photo * dh_step, d.norm() - s.camera_along_m) + nb(rng);
+    ss.push_back(s);
+  }
+  return ss;
+}
+
+TEST(LocateLandmark, HeightRangesALandmarkTheLaserPassesUnder) {
+  // Nearly head-on (the bearings barely cross) to a carton 0.7 m above the camera, from 4.5
+  // to 1.8 m; the laser passes under it to the bench 0.45 m behind (lab: L5, 0.30 m median).
+  const Eigen::Vector2d lm(5.5, 0.4);
+  const auto ss = approach(lm, 0.5, 3.2, 10, 0.1, 0.7, 0.45);
+  LocateParams laser_only;
+  laser_only.height_ranging = false;
+  const LandmarkFix fl = locateLandmark(ss, laser_only);
+  ASSERT_TRUE(fl.ok);
+  EXPECT_FALSE(fl.triangulated);
+  EXPECT_GT((fl.position - lm).norm(), 0.25);  // what the laser alone says
+  EXPECT_EQ(fl.height_ranges, 0);
+
+  const LandmarkFix f = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(f.ok);
+  EXPECT_FALSE(f.bearing_only);
+  // The far sightings' ranges are too uncertain (elevation noise x r^2 / dh) to be used.
+  EXPECT_GE(f.height_ranges, 5);
+  EXPECT_EQ(f.ranges_used, f.height_ranges);
+  EXPECT_LT((f.position - lm).norm(), 0.1) << f.position.transpose();
+  EXPECT_GE(f.height_sigma_m, LocateParams{}.height_min_sigma_m);
+  EXPECT_LE(f.height_sigma_m, LocateParams{}.height_max_sigma_m);
+
+  const HeightRanges hr = heightRanges(ss, LocateParams{});
+  ASSERT_EQ(hr.range_m.size(), ss.size());
+  for (size_t i = 0; i < ss.size(); ++i)
+    if (hr.range_m[i] > 0) EXPECT_NEAR(hr.range_m[i], (lm - ss[i].origin).norm(), 0.15) << i;
+}
+
+TEST(LocateLandmark, HeightRangesWithoutALaserRangeAndPerPhoto) {
+  // No laser range at all (it read beyond), two database photos whose centres differ by 6 cm
+  // in height (one height each): a ranged fix instead of a bearing-only one.
+  const Eigen::Vector2d lm(5.0, -0.3);
+  auto ss = approach(lm, 0.0, 2.8, 12, 0.1, 0.75, -1, 2, 0.06);
+  for (auto& s : ss) s.beyond_m = 7.0;
+  const LandmarkFix f = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(f.ok);
+  EXPECT_FALSE(f.bearing_only);
+  EXPECT_GE(f.height_ranges, 6);
+  EXPECT_LT((f.position - lm).norm(), 0.1) << f.position.transpose();
+}
+
+TEST(LocateLandmark, LaserRangesThatAgreeWithTheHeightAreKept) {
+  const Eigen::Vector2d lm(5.5, 0.4);
+  const auto ss = approach(lm, 0.5, 3.2, 10, 0.1, 0.7, 0.02);
+  const LandmarkFix f = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(f.ok);
+  EXPECT_EQ(f.height_ranges, 0);  // the laser sees the landmark itself: its ranges are better
+  EXPECT_EQ(f.ranges_used, 10);
+  EXPECT_LT((f.position - lm).norm(), 0.1);
+}
+
+TEST(LocateLandmark, NoHeightFromOneDistanceOrAtTheCameraHeight) {
+  const Eigen::Vector2d lm(5.5, 0.4);
+  // Standing still: every sighting from the same place, the height is not observable.
+  auto still = approach(lm, 1.0, 1.0, 8, 0.2, 0.7, 0.45);
+  EXPECT_TRUE(heightRanges(still, LocateParams{}).range_m.empty());
+  // At the camera's height the elevations say nothing (below height_min_elevation_deg).
+  auto level = approach(lm, 0.5, 3.2, 10, 0.0, 0.02, 0.45);
+  EXPECT_TRUE(heightRanges(level, LocateParams{}).range_m.empty());
+  // Too few sightings.
+  auto few = approach(lm, 0.5, 3.2, 3, 0.2, 0.7, 0.45);
+  EXPECT_TRUE(heightRanges(few, LocateParams{}).range_m.empty());
+  // Unknown elevations (a perception without them) range nothing either.
+  auto none = approach(lm, 0.5, 3.2, 10, 0.2, 0.7, 0.45);
+  for (auto& s : none) s.elevation = NAN;
+  EXPECT_TRUE(heightRanges(none, LocateParams{}).range_m.empty());
+}
+
 TEST(LocateLandmark, ParamsAreChecked) {
   LocateParams p;
   p.bearing_sigma_deg = 0;
   EXPECT_THROW(p.validate(), InputError);
   p = {};
   p.range_gate_m = -1;
+  EXPECT_THROW(p.validate(), InputError);
+  p = {};
+  p.height_min_sightings = 2;
+  EXPECT_THROW(p.validate(), InputError);
+  p = {};
+  p.height_max_sigma_m = 0;
   EXPECT_THROW(p.validate(), InputError);
   EXPECT_NO_THROW(LocateParams{}.validate());
 }

@@ -143,6 +143,11 @@ TEST_F(FoveaTest, FindsASmallLandmarkWhereTheHintPointsWithItsFullFrameBearing) 
     EXPECT_TRUE((d.window & cv::Rect(0, 0, 640, 480)) == d.window);
     EXPECT_TRUE(d.window.contains({static_cast<int>(u), 210}));
     EXPECT_EQ(countClass(ob, kOther), 0);
+    // Pasted at row 210 with the camera level: 29.5 px above the centre (foveal crop pixels
+    // mapped back to the frame, like the column).
+    EXPECT_NEAR(d.elevation, std::atan2(K.cy - 210, std::hypot(K.fy, (u - K.cx) * K.fy / K.fx)),
+                3.0 / K.fy);
+    EXPECT_GE(d.photo, 0);
 
     // A hint for the other class at the same place finds nothing: never a guess.
     const Observation other = foveal.observe(f, K, std::vector<LookFor>{{kOther, bearing, 3.0}});
@@ -229,6 +234,24 @@ TEST_F(FoveaTest, CameraYawShiftsThePredictedColumn) {
   EXPECT_EQ(
       countClass(unpanned.observe(f, K, std::vector<LookFor>{{kTarget, bearing, 3.0}}), kTarget),
       0);
+}
+
+// The elevation is the object centre's angle above the horizontal, the camera's tilt included:
+// at the image's centre column it is pitch + atan((cy - v) / fy).
+TEST_F(FoveaTest, ElevationIncludesTheCameraTilt) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 180, K.cx, 150, 12);
+  for (const double pitch : {0.0, 0.21}) {
+    PerceptionParams p = params(false);
+    p.camera_pitch = pitch;
+    LandmarkPerception perception(model_, p);
+    Detection d;
+    ASSERT_EQ(countClass(perception.observe(f, K, std::vector<std::string>{kTarget}), kTarget, &d),
+              1);
+    EXPECT_NEAR(d.elevation, pitch + std::atan((K.cy - 150) / K.fy), 3.0 / K.fy) << pitch;
+  }
 }
 
 // Perception implementations without a fovea get the hinted classes, each once, in order.

@@ -60,6 +60,23 @@ struct LocateParams {
   double range_gate_m = 0.25;       // [m] a range further than this (+ 2 sigma of the
                                     // crossing) from where the bearings cross, or from the
                                     // median range when they do not cross, is left out
+  // Height ranging. A landmark's centre stands at a fixed, unknown height; from distance r
+  // the camera sees it at elevation e with r = dh cot(e). Sightings from different distances
+  // (the robot approaching) give dh and so a range per sighting, from the camera alone: the
+  // rays' points o + (dh cot e) u meet at the landmark only for the right dh (linear least
+  // squares, one dh per database photo matched, as each photo frames the object a little
+  // differently). Where these ranges disagree with the laser's (height_agree_m), the laser hit
+  // something else — the lab's cartons stand ~1 m up and the 0.25 m laser plane passes under
+  // them to the bench behind: L5 was located 0.30 m too far (median, 84 fixes) — and the
+  // height ranges replace them.
+  bool height_ranging = true;
+  int height_min_sightings = 4;             // per photo, with an elevation
+  double height_min_elevation_deg = 3;      // [deg] |elevation| below this ranges nothing
+  double height_elevation_sigma_deg = 0.3;  // [deg] elevation noise (a pixel is 0.1 deg; the
+                                            // floor tilts the robot a little)
+  double height_max_sigma_m = 0.15;         // [m] range error (from the fit) above this: not used
+  double height_min_sigma_m = 0.08;         // [m] floor of a height range's error (shared by all)
+  double height_agree_m = 0.15;             // [m] laser ranges within this (median) are kept
   template <class B>
   void bind(B& b) {
     b("bearing_sigma_deg", bearing_sigma_deg);
@@ -67,6 +84,13 @@ struct LocateParams {
     b("max_along_sigma_m", max_along_sigma_m);
     b("range_sigma_m", range_sigma_m);
     b("range_gate_m", range_gate_m);
+    b("height_ranging", height_ranging);
+    b("height_min_sightings", height_min_sightings);
+    b("height_min_elevation_deg", height_min_elevation_deg);
+    b("height_elevation_sigma_deg", height_elevation_sigma_deg);
+    b("height_max_sigma_m", height_max_sigma_m);
+    b("height_min_sigma_m", height_min_sigma_m);
+    b("height_agree_m", height_agree_m);
   }
   void validate() const;  // InputError "nav.locate.<field> = ...: ..."
 };
@@ -83,7 +107,17 @@ struct LandmarkFix {
   bool bearing_only = false;
   int rays = 0;  // sightings used
   int ranges_used = 0, ranges_dropped = 0;
+  int height_ranges = 0;      // sightings ranged by height (replacing the laser's or none)
+  double height_sigma_m = 0;  // their range error (from the fit)
 };
+
+/// Height ranging alone (see LocateParams): per sighting the range it gives (0: none) and
+/// its error; empty when the sightings do not range the landmark.
+struct HeightRanges {
+  std::vector<double> range_m;
+  double sigma_m = 0;
+};
+HeightRanges heightRanges(const std::vector<Sighting>& sightings, const LocateParams& p);
 
 /// The landmark's position from its sightings (see LocateParams). Not ok when there is no
 /// sighting. With no range and bearings that do not cross well enough, ok and bearing_only.

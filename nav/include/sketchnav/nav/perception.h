@@ -4,6 +4,7 @@
 // each window against the expected classes' database photos (ratio test + RANSAC) and turns
 // the inliers into the servo feature. Tests may substitute their own Perception; `sketchnav
 // run` always uses the real one.
+#include <cmath>
 #include <memory>
 #include <string>
 #include <vector>
@@ -26,6 +27,12 @@ struct Detection {
   double x_t = 0;        // [normalised] current horizontal coordinate of the landmark
   double x_d = 0;        // [normalised] its desired value (database position)
   double bearing = 0;    // [rad] robot frame, CCW positive (from x_t and the camera mount)
+  // [rad] angle of the object's centre (the database photo's centre through the homography)
+  // above the camera's horizontal plane (camera_pitch removed); NaN when unknown. The
+  // landmark's height does not change, so how this grows as the robot approaches ranges it
+  // where the laser cannot (locateLandmark: an elevated carton, the laser passing under it).
+  double elevation = NAN;
+  int photo = -1;  // database photo matched: elevations compare within one photo (its framing)
 };
 
 struct PerceptionTiming {
@@ -70,6 +77,7 @@ struct PerceptionParams {
   bool paper_offset = true;  // feature from the paper's median (x_t - x_d) over inliers;
                              // false: the homography-projected object centre
   double camera_yaw = 0;     // [rad] camera pan on the robot (bearing = yaw - atan(x))
+  double camera_pitch = 0;   // [rad] camera tilt, up positive (for Detection::elevation)
   double merge_iou = 0.3;    // detections of a class overlapping more are one landmark
   // SIFT settings for camera frames (the model's photo settings are 400 px / 500 keypoints).
   // Describing 640 px frames at full size with 1500 keypoints roughly doubles the inliers on
@@ -110,6 +118,7 @@ struct PerceptionParams {
     b("max_photos", max_photos);
     b("paper_offset", paper_offset);
     b("camera_yaw", camera_yaw);
+    b("camera_pitch", camera_pitch);
     b("merge_iou", merge_iou);
     b("frame_max_side", frame_max_side);
     b("frame_max_features", frame_max_features);

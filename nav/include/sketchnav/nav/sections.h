@@ -9,6 +9,7 @@
 // not fix a heading), so the rest of the route is followed relative to that landmark.
 #include <Eigen/Core>
 
+#include <cmath>
 #include <vector>
 
 #include "sketchnav/hw/types.h"
@@ -46,6 +47,13 @@ struct Sighting {
   // trusted (it may hit what stands beyond): that reading [m], as the sighting's distance
   // for the weight of its bearing (the landmark is no further). 0: unknown.
   double beyond_m = 0;
+  // The landmark centre's elevation seen from the camera [rad] (NaN: unknown), the camera's
+  // distance ahead of `origin` along this bearing [m], and the database photo matched: with
+  // the landmark's height unknown but fixed, elevations from different distances range it
+  // (locateLandmark, LocateParams::height_ranging).
+  double elevation = NAN;
+  double camera_along_m = 0;
+  int photo = -1;
 };
 
 /// One fix for SectionTracker::fitSimilarityWeighted(): where the sketch puts a point (route
