@@ -7,14 +7,13 @@
 
 namespace sketchnav::landmarks {
 
-cv::Mat colourThumbnail(const cv::Mat& image) {
+cv::Mat colourThumbnail(const cv::Mat& image, int max_side) {
   if (image.empty()) return {};
   cv::Mat bgr = image;
   if (image.channels() == 1) cv::cvtColor(image, bgr, cv::COLOR_GRAY2BGR);
   if (image.channels() == 4) cv::cvtColor(image, bgr, cv::COLOR_BGRA2BGR);
   if (bgr.depth() != CV_8U) bgr.convertTo(bgr, CV_8U);
-  const double s =
-      std::min(1.0, static_cast<double>(kColourThumbnailSide) / std::max(bgr.cols, bgr.rows));
+  const double s = std::min(1.0, static_cast<double>(max_side) / std::max(bgr.cols, bgr.rows));
   if (s >= 1) return bgr.clone();
   cv::Mat small;
   const cv::Size size(std::max(1, static_cast<int>(std::lround(bgr.cols * s))),

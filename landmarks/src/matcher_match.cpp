@@ -345,8 +345,9 @@ ServoOffset servoOffset(const MatchResult& m, int frame_width) {
     const cv::Mat& H = m.H;
     const double w = H.at<double>(2, 0) * dcx + H.at<double>(2, 1) * dcy + H.at<double>(2, 2);
     if (std::abs(w) > 1e-9) {
-      u = static_cast<float>(
-          (H.at<double>(0, 0) * dcx + H.at<double>(0, 1) * dcy + H.at<double>(0, 2)) / w);
+      o.centre_u = (H.at<double>(0, 0) * dcx + H.at<double>(0, 1) * dcy + H.at<double>(0, 2)) / w;
+      o.centre_v = (H.at<double>(1, 0) * dcx + H.at<double>(1, 1) * dcy + H.at<double>(1, 2)) / w;
+      u = static_cast<float>(o.centre_u);
       const double det =
           H.at<double>(0, 0) * H.at<double>(1, 1) - H.at<double>(0, 1) * H.at<double>(1, 0);
       scale = std::sqrt(std::abs(det)) / std::abs(w);

@@ -137,16 +137,7 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
     detectSift(img, params.features, ph.keypoints, ph.sift_u8);
     addSynthesisedViews(img, params, ph.keypoints, ph.sift_u8);
     ph.colours = keypointColours(img, ph.keypoints);
-    {
-      const double f = static_cast<double>(kPhotoThumbnailSide) / std::max(img.cols, img.rows);
-      if (f < 1)
-        cv::resize(img, ph.thumbnail,
-                   cv::Size(std::max(1, static_cast<int>(std::lround(img.cols * f))),
-                            std::max(1, static_cast<int>(std::lround(img.rows * f)))),
-                   0, 0, cv::INTER_AREA);
-      else
-        ph.thumbnail = img.clone();
-    }
+    ph.thumbnail = colourThumbnail(img, kPhotoThumbnailSide);
     if (ph.keypoints.size() < 5) {
       log::warn("landmarks", "skipping photo with too little texture",
                 {{"file", items[i].path}, {"features", std::to_string(ph.keypoints.size())}});

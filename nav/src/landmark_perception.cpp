@@ -81,15 +81,10 @@ landmarks::MatchParams matchParams(const PerceptionParams& P) {
 }
 
 // Elevation [rad] above the camera's horizontal plane of the matched object's centre (the
-// database photo's centre through H), the camera tilted up by `pitch`; NaN without a usable H.
-double elevationOf(const landmarks::MatchResult& m, const hw::Intrinsics& K, double pitch) {
-  if (m.H.empty()) return NAN;
-  const cv::Mat& H = m.H;
-  const double dcx = 0.5 * m.database_size.width, dcy = 0.5 * m.database_size.height;
-  const double w = H.at<double>(2, 0) * dcx + H.at<double>(2, 1) * dcy + H.at<double>(2, 2);
-  if (std::abs(w) < 1e-9) return NAN;
-  const double u = (H.at<double>(0, 0) * dcx + H.at<double>(0, 1) * dcy + H.at<double>(0, 2)) / w;
-  const double v = (H.at<double>(1, 0) * dcx + H.at<double>(1, 1) * dcy + H.at<double>(1, 2)) / w;
+// database photo's centre through H, servoOffset()), the camera tilted up by `pitch`; NaN
+// without a usable H.
+double elevationOf(const landmarks::ServoOffset& off, const hw::Intrinsics& K, double pitch) {
+  const double u = off.centre_u, v = off.centre_v;
   if (!std::isfinite(u) || !std::isfinite(v) || v < -K.height || v > 2.0 * K.height) return NAN;
   // The ray (x, y, 1) in the optical frame (y down), in the robot's frame (x ahead, z up).
   const double x = (u - K.cx) / K.fx, y = (v - K.cy) / K.fy;
@@ -114,7 +109,7 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   d.x_d = d.x_t - err_px / K.fx;
   d.bearing = P.camera_yaw - std::atan(d.x_t);
   d.photo = m.database_photo;
-  d.elevation = elevationOf(m, K, P.camera_pitch);
+  d.elevation = elevationOf(off, K, P.camera_pitch);
   return true;
 }
 }  // namespace

@@ -109,7 +109,7 @@ TEST(LocateLandmark, OneStrayRangeDoesNotMoveARangesOnlyFix) {
   EXPECT_NEAR(f.position.x(), 6.0, 1e-6);
 }
 
-// The robot heads for a landmark whose centre stands dh above the camera (the camera
+// driveBy() heading for a landmark whose centre stands dh above the camera (the camera
 // `camera_along` ahead of the origin), from x0 to x1 in n sightings: bearings and elevations
 // with Gaussian noise of sigma_deg, laser ranges `range_bias` long (<= -1: none), the
 // database photo alternating between `photos` of them whose centres sit dh_step apart in
@@ -118,19 +118,16 @@ std::vector<Sighting> approach(const Eigen::Vector2d& lm, double x0, double x1, 
                                double sigma_deg, double dh, double range_bias, int photos = 1,
                                double dh_step = 0.0, std::uint32_t seed = 5) {
   const double camera_along = 0.13;
-  std::mt19937 rng(seed);
-  std::normal_distribution<double> nb(0.0, sigma_deg * M_PI / 180);
-  std::vector<Sighting> ss;
+  auto ss = driveBy(lm, x0, x1, n, sigma_deg, std::max(range_bias, 0.0), seed);
+  std::mt19937 rng(seed + 1);
+  std::normal_distribution<double> ne(0.0, sigma_deg * M_PI / 180);
   for (int i = 0; i < n; ++i) {
-    const Eigen::Vector2d o(x0 + (x1 - x0) * i / std::max(1, n - 1), 0.0);
-    const Eigen::Vector2d d = lm - o;
-    const double a = std::atan2(d.y(), d.x());
-    Sighting s{o, a + nb(rng), range_bias <= -1 ? 0.0 : d.norm() + range_bias};
-    const int photo = i % photos;
-    s.photo = photo;
-    s.camera_along_m = camera_along * std::cos(a);
-    s.elevation = std::atan2(dh + photo * dh_step, d.norm() - s.camera_along_m) + nb(rng);
-    ss.push_back(s);
+    Sighting& s = ss[i];
+    const Eigen::Vector2d d = lm - s.origin;
+    if (range_bias <= -1) s.range_m = 0;
+    s.photo = i % photos;
+    s.camera_along_m = camera_along * std::cos(std::atan2(d.y(), d.x()));
+    s.elevation = std::atan2(dh + s.photo * dh_step, d.norm() - s.camera_along_m) + ne(rng);
   }
   return ss;
 }

@@ -48,10 +48,11 @@ constexpr int kColourLayoutSide = 64;       // [px] the region is resized to thi
 constexpr int kColourThumbnailSide = 160;   // [px] longer side of the stored frame thumbnail
 constexpr double kColourLayoutTrim = 0.02;  // keypoints left out per side of the region box
 
-/// The image shrunk (INTER_AREA) so its longer side is at most kColourThumbnailSide, BGR
-/// CV_8UC3 (grey and BGRA inputs converted); empty for an empty image. Kept per frame in
-/// FrameFeatures so recognise() can describe any window's colours without the frame.
-cv::Mat colourThumbnail(const cv::Mat& image);
+/// The image shrunk (INTER_AREA) so its longer side is at most `max_side`, BGR CV_8UC3 (grey
+/// and BGRA inputs converted); empty for an empty image. Kept per frame in FrameFeatures so
+/// recognise() can describe any window's colours without the frame (and, at
+/// kPhotoThumbnailSide, per database photo for the sibling check).
+cv::Mat colourThumbnail(const cv::Mat& image, int max_side = kColourThumbnailSide);
 
 /// The region box of `keypoints` (image pixels): the bounding box after trimming
 /// kColourLayoutTrim of the points on each side of each axis, clipped to the image. With fewer

@@ -12,6 +12,7 @@
 // offset_px / f_x (normalised x) directly, and needs no geometry of its own.
 #include <opencv2/core.hpp>
 
+#include <cmath>
 #include <map>
 #include <memory>
 #include <mutex>
@@ -137,6 +138,9 @@ struct ServoOffset {
   float offset_px = 0;        // [px] object_u − frame_width / 2 (> 0: object right of centre)
   float paper_offset_px = 0;  // [px] median over inliers of (x_t − frame_cx) − s (x_d − db_cx),
                               //      s = frame/database scale from H: the paper's x_t − x_d
+  // [px] the database photo's centre through H, unrounded (NaN without a usable H): where
+  // object_u comes from when H is sane, and the row an elevation angle is read from.
+  double centre_u = NAN, centre_v = NAN;
 };
 /// Robust offsets from a match (the homography-projected database centre; falls back to
 /// the median inlier column when the homography is degenerate). Invalid when not matched.
