@@ -198,6 +198,7 @@ struct Executive::Impl {
   Eigen::Vector2d detour_goal{1e300, 1e300};
   bool detouring = false;
   bool moving_seen = false;  // the current manoeuvre has seen something come towards the robot
+  bool in_lane = false;      // a walker's lane covered the robot at the last step
   // Final look: at the goal, a landmark never seen (too far so far) is looked for before
   // arriving. Which one, since when, whether it had been missed, whether the look is over.
   int fl_k = -1, fl_i = -1;
@@ -338,12 +339,14 @@ struct Executive::Impl {
       }
     }
     if (have_pose) pose = lodo.pose();
-    if (have_pose && (s.exec.detour || s.movers.enabled)) {
+    if (have_pose) {
       for (size_t i : fresh) {
         movers.update(pose, scans[i], grid_before);
         planner.insert(pose, scans[i]);
       }
-      if (s.movers.enabled && now - snap_t >= 1.5) {
+      // The avoider follows walkers the tracker finds (avoidance.h), so the grid of a few
+      // seconds ago is kept whenever the tracker runs.
+      if (now - snap_t >= 1.5) {
         grid_before = std::move(grid_snap);
         grid_snap = planner.snapshot();
         snap_t = now;
@@ -707,8 +710,15 @@ struct Executive::Impl {
       if (docking) v = avoider.capSpeed(scans, v);
     } else if (!dev.ranges.empty()) {
       avoider.setPose(pose);
+      for (const auto& m : movers.walkers()) avoider.offerWalker(m.position, m.velocity);
       const auto av = avoider.step(scans, target_bearing, side, pose.theta, s.exec.v_cruise, now);
       front = av.front_free_m;
+      if (av.in_lane && !in_lane)
+        event({{"type", "walker_lane"},
+               {"walker_odom", {av.walker_pos.x(), av.walker_pos.y()}},
+               {"walker_velocity", {av.walker_vel.x(), av.walker_vel.y()}},
+               {"section", k}});
+      in_lane = av.in_lane;
       if (av.started) {
         ++manoeuvres;
         event({{"type", "avoid_start"},

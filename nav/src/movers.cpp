@@ -37,7 +37,9 @@ double segDist(const Eigen::Vector2d& p, const Eigen::Vector2d& a, const Eigen::
 
 void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
                           const LocalPlanner& grid) {
-  if (!p_.enabled || s.kind != hw::RangeScan::Kind::Laser) return;
+  // Tracking runs whether or not the lanes are kept (`enabled`): the avoider follows the
+  // movers found here (ObstacleAvoider::offerWalker).
+  if (s.kind != hw::RangeScan::Kind::Laser) return;
   const double c = std::cos(robot.theta), sn = std::sin(robot.theta);
   // Clusters of consecutive valid beams (odometry frame).
   struct Cluster {
@@ -153,6 +155,17 @@ std::vector<Mover> MoverTracker::movers() const {
     const double sp = tr.fit_vel.norm();
     if (tr.steady && tr.born_free && 4 * tr.free_hits >= tr.updates &&
         tr.updates >= p_.min_updates && sp >= p_.min_speed && sp <= 1.8)
+      out.push_back({tr.pos, tr.fit_vel, tr.updates});
+  }
+  return out;
+}
+
+std::vector<Mover> MoverTracker::walkers() const {
+  std::vector<Mover> out;
+  for (const auto& tr : tracks_) {
+    const double sp = tr.fit_vel.norm();
+    if (tr.steady && 4 * tr.free_hits >= 3 * tr.updates && tr.updates >= p_.min_updates &&
+        sp >= p_.min_speed && sp <= 1.8)
       out.push_back({tr.pos, tr.fit_vel, tr.updates});
   }
   return out;

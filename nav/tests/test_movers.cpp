@@ -87,12 +87,14 @@ TEST(Movers, TheRobotDoesNotDriveIntoALane) {
   EXPECT_FALSE(tr.advise({0, 0, M_PI}, 0.3, 0.0, 1.5, 0.3).active);
 }
 
-TEST(Movers, OffByDefaultAndThenNoAdvice) {
+TEST(Movers, LanesOffByDefaultAndThenNoAdviceButStillTracked) {
   EXPECT_FALSE(MoverParams{}.enabled);
   LocalPlanner grid;
-  // The same crossing that stops the robot when the tracker is on.
+  // The same crossing that stops the robot when the lanes are kept: still tracked (the
+  // avoider follows it), but no advice.
   const auto tr = watch(grid, {0, 0, 0}, {0.8, 2.5}, {0.0, -0.4}, 1.0, /*enabled=*/false);
-  EXPECT_TRUE(tr.movers().empty());
+  ASSERT_EQ(tr.movers().size(), 1u);
+  EXPECT_NEAR(tr.movers()[0].velocity.y(), -0.4, 0.1);
   EXPECT_FALSE(tr.advise({0, 0, 0}, 0.3, 0.0, 1.5, 0.3).active);
   MoverParams p;
   p.min_updates = 1;

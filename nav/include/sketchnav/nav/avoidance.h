@@ -47,6 +47,15 @@ struct AvoidParams {
   double approach_horizon_s = 3.0;   // [s] an obstacle coming towards the robot (a pedestrian)
                                      // triggers this much earlier (its speed x horizon)
   double reverse_speed = 0.12;       // [m/s] back-off speed when something keeps coming closer
+  // Someone walking towards the robot is followed from scan to scan (a person-sized group of
+  // laser points, with its velocity) for as long as it is in view, not only while it closes
+  // the corridor ahead. While its lane (its straight path over lane_horizon_s, as wide as
+  // both bodies plus lane_margin_m) covers the robot, the manoeuvre is held and every
+  // direction taken leaves the lane at lane_escape_deg or more to its axis.
+  double lane_horizon_s = 6.0;       // [s]
+  double person_radius_m = 0.3;      // [m]
+  double lane_margin_m = 0.15;       // [m]
+  double lane_escape_deg = 60;       // [deg] from the lane's axis (90 = straight out sideways)
   int sectors = 144;                 // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
@@ -66,6 +75,10 @@ struct AvoidParams {
     b("k_heading", k_heading);
     b("approach_horizon_s", approach_horizon_s);
     b("reverse_speed", reverse_speed);
+    b("lane_horizon_s", lane_horizon_s);
+    b("person_radius_m", person_radius_m);
+    b("lane_margin_m", lane_margin_m);
+    b("lane_escape_deg", lane_escape_deg);
     b("sectors", sectors);
   }
   void validate() const;  // InputError "nav.avoid.<field> = ...: ..."
@@ -92,6 +105,8 @@ struct AvoidOutput {
   double clearance_m = 0;       // nearest obstacle to the body [m]
   bool blocked = false;         // forward motion refused by the minimum clearance
   double approach_speed = 0;    // [m/s] estimated speed of the obstacle ahead towards the robot
+  bool in_lane = false;         // a walker's lane covers the robot (held, stepping out)
+  Eigen::Vector2d walker_pos{0, 0}, walker_vel{0, 0};  // that walker (odometry frame)
 };
 
 class ObstacleAvoider {
@@ -118,6 +133,11 @@ class ObstacleAvoider {
     pose_ = pose;
     have_pose_ = true;
   }
+  /// People walking tracked elsewhere (movers.h, odometry frame): one coming towards the robot
+  /// whose lane covers it is followed from the next scan on, also when it is not ahead (a
+  /// walker coming at the robot from the side while it servoes on a landmark beside their
+  /// lane). The avoider's own detection sees only what closes the corridor ahead.
+  void offerWalker(const Eigen::Vector2d& position, const Eigen::Vector2d& velocity);
   bool active() const { return active_; }
   void reset();
   const AvoidParams& params() const { return params_; }
@@ -142,6 +162,20 @@ class ObstacleAvoider {
   Eigen::Vector2d prev_pt_{0, 0};  // nearest obstacle point ahead at the last scan (odometry)
   double prev_pt_t_ = 0;
   bool have_prev_pt_ = false;
+  // The walker followed (odometry frame): centre of its laser points, filtered velocity.
+  struct Walker {
+    bool valid = false;
+    Eigen::Vector2d pos{0, 0}, vel{0, 0};
+    double t = 0;
+  } walker_;
+  int lane_sign_ = 0;  // side of the walker's axis the robot steps out to (+-1 x its left)
+  void followWalker(const std::vector<hw::RangeScan>& scans, double stamp, bool acquire);
+  /// The unit normal from the walker's lane axis towards the robot, and the robot's offset
+  /// from the axis [m], when the lane covers the robot; false otherwise.
+  bool inLane(Eigen::Vector2d& normal, double& offset) const;
+  void laneEscape(const std::vector<std::pair<double, double>>& pts, double target_bearing,
+                  double heading, double v_nominal, const Eigen::Vector2d& lane_n,
+                  double lane_off, AvoidOutput& out);
 };
 
 }  // namespace sketchnav::nav

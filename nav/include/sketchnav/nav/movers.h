@@ -22,10 +22,12 @@ namespace sketchnav::nav {
 class LocalPlanner;
 
 struct MoverParams {
-  // Off by default: in the lab the tracker still reports phantom movers (occlusion edges of
-  // small furniture while the robot drives: 2-8 lane events per run where nobody walks), and
-  // yielding to them changed closed-loop runs for the worse (lab seed 1 "lost", the
-  // pedestrian-right trial it was made for still collided). `--set nav.movers.enabled=true`.
+  // Keeping out of every mover's lane (advise()) is off by default: in the lab the tracker
+  // still reports phantom movers (occlusion edges of small furniture while the robot drives:
+  // 2-8 lane events per run where nobody walks), and yielding to them changed closed-loop runs
+  // for the worse (lab seed 1 "lost", the pedestrian-right trial it was made for still
+  // collided). `--set nav.movers.enabled=true`. The tracking itself always runs: the avoider
+  // steps out of the lane of a mover coming at the robot (avoidance.h).
   bool enabled = false;
   double cluster_gap_m = 0.15;   // [m] consecutive beams further apart start a new cluster
   double max_width_m = 0.8;      // [m] wider clusters are furniture or walls
@@ -82,6 +84,11 @@ class MoverTracker {
   void update(const hw::Pose2D& robot, const hw::RangeScan& laser, const LocalPlanner& grid);
   /// Tracks moving faster than min_speed after min_updates scans.
   std::vector<Mover> movers() const;
+  /// The same, without requiring a track's first points to lie on floor seen free, but three
+  /// quarters of them: a person already walking when first in view (the lab's walker, seen
+  /// first across the room) is first seen where the grid had not yet seen the floor. For the
+  /// avoider, which acts only on one coming at the robot whose lane covers it.
+  std::vector<Mover> walkers() const;
   /// Advice for a robot at `robot` about to command (v, w): stop rather than enter a lane,
   /// step out of one it is in. `k_heading`, `v_max`: how it turns and how fast it may go.
   YieldAdvice advise(const hw::Pose2D& robot, double v, double w, double k_heading,
