@@ -133,7 +133,10 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
         ++ring;
     }
     if (n == 0 || ring > 2) return false;
-    out = sum / n;
+    // The beams hit the near side: the body's centre is further away (as the mover tracker
+    // takes it, so a walker it hands over does not jump).
+    const Eigen::Vector2d mean = sum / n, robot(pose_.x, pose_.y);
+    out = mean + (mean - robot).normalized() * 0.5 * params_.person_radius_m;
     return true;
   };
   if (walker_.valid) {
@@ -152,16 +155,18 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
   }
   Eigen::Vector2d m;
   if (acquire && have_prev_pt_ && centre(prev_pt_, m)) {
-    // Seeded with the approach rate along the line of sight; the track refines the direction.
-    const Eigen::Vector2d los = Eigen::Vector2d(pose_.x, pose_.y) - m;
-    walker_.valid = los.norm() > 1e-6;
+    // At rest until its own motion is measured: the approach estimate also fires on static
+    // things (noise, a surface sliding into view), and seeded with it such a thing had a lane
+    // for half a second (in 2 of 4 exp2-redrawn-c trials, at the start in room A).
+    walker_.valid = true;
     walker_.pos = m;
-    walker_.vel = approach_ * los.normalized();
+    walker_.vel.setZero();
     walker_.t = stamp;
   }
 }
 
-void ObstacleAvoider::offerWalker(const Eigen::Vector2d& position, const Eigen::Vector2d& velocity) {
+void ObstacleAvoider::offerWalker(const Eigen::Vector2d& position,
+                                  const Eigen::Vector2d& velocity) {
   if (walker_.valid || !have_pose_ || prev_stamp_ < -1e299) return;
   const Eigen::Vector2d d = Eigen::Vector2d(pose_.x, pose_.y) - position;
   if (velocity.dot(d) <= 0) return;  // walking away
@@ -201,8 +206,7 @@ double ObstacleAvoider::capSpeed(const std::vector<hw::RangeScan>& scans, double
 
 void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& pts,
                                  double target_bearing, double heading, double v_nominal,
-                                 const Eigen::Vector2d& lane_n, double lane_off,
-                                 AvoidOutput& out) {
+                                 const Eigen::Vector2d& lane_n, double lane_off, AvoidOutput& out) {
   // Out of the walker's lane, steeply: a shallow angle gains too little sideways before they
   // arrive (at 25 deg off the axis an exp4-pedestrian-left robot gained 0.13 m/s and was
   // walked into 0.07 m short of clear). Of the directions that leave steeply enough, the one
@@ -225,7 +229,6 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
       lane_sign_ = (toRobot(perp).y() >= 0) == (side_ == DodgeSide::Left) ? 1 : -1;
   }
   const std::vector<Eigen::Vector2d> normals{lane_sign_ * perp, -lane_sign_ * perp};
-  (void)lane_n;
   const double need = std::sin(P.lane_escape_deg * M_PI / 180);
   auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= P.trigger_m; };
   bool found = false;
@@ -370,10 +373,9 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   const double target_free = corridorFree(pts, toward, hw, P.max_range_m);
 
   // A walker whose lane covers the robot, this near: time to step out of it.
-  const double walker_gap =
-      lane ? (walker_.pos - Eigen::Vector2d(pose_.x, pose_.y)).norm() - P.robot_radius_m -
-                 P.person_radius_m
-           : 1e9;
+  const double walker_gap = lane ? (walker_.pos - Eigen::Vector2d(pose_.x, pose_.y)).norm() -
+                                       P.robot_radius_m - P.person_radius_m
+                                 : 1e9;
   if (!active_) {
     if (std::min(out.front_free_m, target_free) >= trigger &&
         walker_gap >= P.trigger_m + walker_.vel.norm() * P.approach_horizon_s) {

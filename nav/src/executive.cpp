@@ -145,6 +145,11 @@ struct LmTrack {
   LmState state = LmState::Pending;
   int frames_seen = 0, max_inliers = 0;
   double last_seen = -1e300, last_range = 0, last_bearing = 0;
+  // Where it was last seen (odometry frame): the ray's origin and direction, and its point
+  // when it had a range. While it is being tracked, detections are matched against this, not
+  // against where the sketch puts it.
+  Eigen::Vector2d last_origin{0, 0};
+  double last_world_bearing = 0, last_point_range = 0;
   std::vector<Sighting> sightings;  // within fix range, for locateLandmark()
 };
 }  // namespace
@@ -507,6 +512,18 @@ struct Executive::Impl {
       std::vector<Candidate> all;
       for (const auto& d : ob.detections) all.push_back({&d, rangeAt(d.bearing)});
       std::vector<bool> used(all.size(), false);
+      // A landmark being tracked is expected where it was last seen, and its detection is not
+      // another landmark's (landmark_stage.h: claimedByTracked).
+      std::vector<Expected> expect(att.size());
+      for (size_t n = 0; n < att.size(); ++n) {
+        const LmTrack& t = *att[n].tr;
+        expect[n].class_name = att[n].lm->class_name;
+        expect[n].tracked = t.state == LmState::Tracking;
+        expect[n].where =
+            expect[n].tracked
+                ? expectedFromTrack(pose, t.last_origin, t.last_world_bearing, t.last_point_range)
+                : att[n].pred;
+      }
       for (size_t n = 0; n < att.size() && status == RunStatus::Running; ++n) {
         auto& x = att[n];
         if (!x.attend) continue;
@@ -514,10 +531,11 @@ struct Executive::Impl {
         std::vector<Candidate> cands;
         std::vector<size_t> idx;
         for (size_t c = 0; c < all.size(); ++c)
-          if (!used[c] && !atEarlierFix(x.lm->class_name, *all[c].detection, all[c].range_m))
+          if (!used[c] && !atEarlierFix(x.lm->class_name, *all[c].detection, all[c].range_m) &&
+              !claimedByTracked(all[c], n, expect))
             cands.push_back(all[c]), idx.push_back(c);
-        const int ci =
-            selectCandidate(cands, x.lm->class_name, x.pred.bearing, x.pred.range, s.select);
+        const int ci = selectCandidate(cands, x.lm->class_name, expect[n].where.bearing,
+                                       expect[n].where.range, s.select);
         if (ci < 0) continue;
         used[idx[ci]] = true;
         const auto& d = *cands[ci].detection;
@@ -541,6 +559,9 @@ struct Executive::Impl {
         t.last_seen = now;
         t.last_range = range;
         t.last_bearing = d.bearing;
+        t.last_origin = {pose.x, pose.y};
+        t.last_world_bearing = pose.theta + d.bearing;
+        t.last_point_range = range;
         // Far ranges may be something else along the bearing; the bearing still helps.
         const bool far = range > fixRange();
         if (!far || s.exec.fit_bearing_only) {

@@ -47,6 +47,26 @@ int selectCandidate(const std::vector<Candidate>& cands, const std::string& clas
   return best;
 }
 
+Polar expectedFromTrack(const hw::Pose2D& robot, const Eigen::Vector2d& origin,
+                        double world_bearing, double range) {
+  if (range <= 0) return {wrapAngle(world_bearing - robot.theta), 0.0};
+  return polarFrom(
+      robot, origin + range * Eigen::Vector2d(std::cos(world_bearing), std::sin(world_bearing)));
+}
+
+bool claimedByTracked(const Candidate& c, size_t self, const std::vector<Expected>& expected) {
+  if (!c.detection) return false;
+  for (size_t m = 0; m < expected.size(); ++m) {
+    const auto& e = expected[m];
+    if (m == self || !e.tracked || e.class_name != c.detection->class_name) continue;
+    const double db = std::abs(wrapAngle(c.detection->bearing - e.where.bearing));
+    const bool range_ok =
+        c.range_m <= 0 || e.where.range <= 0 || std::abs(c.range_m - e.where.range) < 0.75;
+    if (db < 10 * M_PI / 180 && range_ok) return true;
+  }
+  return false;
+}
+
 void LocateParams::validate() const {
   require(bearing_sigma_deg > 0 && bearing_sigma_deg < 30, "nav.locate.bearing_sigma_deg",
           "must be in (0, 30)");

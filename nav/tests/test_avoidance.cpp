@@ -191,8 +191,7 @@ TEST(Avoider, KeepsOutOfAWalkersLaneUntilTheyHavePassed) {
         a.setPose(pose);
         const auto scan = test::scanAt(pose, scene, {walker}, t);
         const auto out = a.step({scan}, tb, DodgeSide::Right, pose.theta, 0.3, t);
-        const double v =
-            out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
+        const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
         const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
         pose.x += v * std::cos(pose.theta) * 0.1;
         pose.y += v * std::sin(pose.theta) * 0.1;
@@ -202,6 +201,44 @@ TEST(Avoider, KeepsOutOfAWalkersLaneUntilTheyHavePassed) {
       EXPECT_GT(min_d, 0.45 + 0.05) << "lane " << lane_y << " start " << start_x;
       EXPECT_TRUE(arrived) << "lane " << lane_y << " start " << start_x;
     }
+  }
+}
+
+TEST(Avoider, StepsOutOfTheLaneOfAWalkerTheTrackerSawComingFromTheSide) {
+  // The robot drives east; a walker 1.9 m ahead and 0.6 m to its right walks west, slightly
+  // north, outside the corridor ahead (the avoider's own estimate does not fire); their line
+  // passes 0.3 m right of the robot. Offered by the mover tracker, their lane covers the
+  // robot: a manoeuvre starts and leaves the lane steeply, to the left (the robot's side of
+  // their line). Walking away, or a lane passing clear of the robot, is not taken.
+  const hw::Pose2D pose{0, 0, 0};
+  const Eigen::Vector2d at(1.9, -0.6), vel(-0.395, 0.062);
+  {
+    ObstacleAvoider a;
+    a.setPose(pose);
+    auto scan = test::scanAt(pose, {}, {{at.x(), at.y(), 0.25}}, 0.0);
+    ASSERT_FALSE(a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.3, 0.0).active);
+    a.offerWalker(at, vel);
+    a.setPose(pose);
+    scan = test::scanAt(pose, {}, {{at.x() + 0.1 * vel.x(), at.y() + 0.1 * vel.y(), 0.25}}, 0.1);
+    const auto out = a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.3, 0.1);
+    EXPECT_TRUE(out.in_lane);
+    ASSERT_TRUE(out.active);
+    EXPECT_EQ(out.side, DodgeSide::Left);
+    // At least lane_escape_deg from the lane's axis.
+    const double axis = std::atan2(vel.y(), vel.x());
+    EXPECT_GE(std::abs(std::sin(out.direction - axis)),
+              std::sin(AvoidParams{}.lane_escape_deg * M_PI / 180) - 1e-9);
+  }
+  for (const Eigen::Vector2d v : {Eigen::Vector2d(0.38, -0.12), Eigen::Vector2d(-0.1, -0.4)}) {
+    ObstacleAvoider a;
+    a.setPose(pose);
+    auto scan = test::scanAt(pose, {}, {{at.x(), at.y(), 0.25}}, 0.0);
+    a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.3, 0.0);
+    a.offerWalker(at, v);
+    scan = test::scanAt(pose, {}, {{at.x() + 0.1 * v.x(), at.y() + 0.1 * v.y(), 0.25}}, 0.1);
+    const auto out = a.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.3, 0.1);
+    EXPECT_FALSE(out.in_lane) << v.transpose();
+    EXPECT_FALSE(out.active) << v.transpose();
   }
 }
 

@@ -114,6 +114,37 @@ TEST(SelectCandidate, RejectsDetectionsInconsistentWithTheSketch) {
   EXPECT_EQ(selectCandidate({{&ok, 2.0}}, "cup", 0.0, 2.0, p), -1);
 }
 
+TEST(SelectCandidate, ATrackedLandmarkKeepsItsDetection) {
+  // The exp4-repeated-b mix-up: L5 (a bin) is tracked, last seen 2.7 m away at -14 deg when
+  // the robot faced 34 deg; the robot has since turned to 2 deg and moved 0.5 m. The sketch
+  // puts L5 45 deg off its detection (outside the gate) and the next bin, L6, 12 deg off it.
+  const hw::Pose2D then{9.58, 6.78, 34 * M_PI / 180}, now{10.09, 6.91, 2 * M_PI / 180};
+  const Polar l5 = expectedFromTrack(now, {then.x, then.y}, then.theta - 13.7 * M_PI / 180, 2.26);
+  EXPECT_NEAR(l5.bearing * 180 / M_PI, 19.7, 1.0);  // where it now is (the simulator: 19.8)
+  EXPECT_NEAR(l5.range, 1.74, 0.05);
+  const Detection seen = det("bin", 19.4), other = det("bin", -16);
+  const std::vector<Candidate> cands{{&seen, 1.8}, {&other, 5.6}};
+  std::vector<Expected> exp{{"bin", true, l5}, {"bin", false, {7.2 * M_PI / 180, 3.8}}};
+  SelectParams p;
+  // From the sketch alone L5 rejects its own detection and L6 takes it.
+  EXPECT_EQ(selectCandidate(cands, "bin", 64 * M_PI / 180, 1.4, p), -1);
+  EXPECT_EQ(selectCandidate(cands, "bin", 7.2 * M_PI / 180, 3.8, p), 0);
+  // Expected where it was last seen, L5 takes it, and for L6 it is L5's.
+  EXPECT_EQ(selectCandidate(cands, "bin", l5.bearing, l5.range, p), 0);
+  EXPECT_TRUE(claimedByTracked(cands[0], 1, exp));
+  EXPECT_FALSE(claimedByTracked(cands[0], 0, exp));  // not by itself
+  EXPECT_FALSE(claimedByTracked(cands[1], 1, exp));  // the other bin is free for L6
+  // Another class, or L5 no longer tracked: not claimed.
+  const Detection cup = det("cup", 19.4);
+  EXPECT_FALSE(claimedByTracked({&cup, 1.8}, 1, exp));
+  exp[0].tracked = false;
+  EXPECT_FALSE(claimedByTracked(cands[0], 1, exp));
+  // Without a range the track still gives the bearing.
+  const Polar ray = expectedFromTrack(now, {then.x, then.y}, 0.3, 0.0);
+  EXPECT_NEAR(ray.bearing, 0.3 - now.theta, 1e-12);
+  EXPECT_EQ(ray.range, 0.0);
+}
+
 TEST(SectionTracker, RealignCorrectsAWrongStartHeading) {
   // The robot really started 25 deg right of the first section: a landmark the sketch puts
   // 4 m straight ahead is seen 25 deg to the right. Realigning about the start fixes the

@@ -52,11 +52,11 @@ struct AvoidParams {
   // the corridor ahead. While its lane (its straight path over lane_horizon_s, as wide as
   // both bodies plus lane_margin_m) covers the robot, the manoeuvre is held and every
   // direction taken leaves the lane at lane_escape_deg or more to its axis.
-  double lane_horizon_s = 6.0;       // [s]
-  double person_radius_m = 0.3;      // [m]
-  double lane_margin_m = 0.15;       // [m]
-  double lane_escape_deg = 60;       // [deg] from the lane's axis (90 = straight out sideways)
-  int sectors = 144;                 // polar diagram resolution over 360 deg
+  double lane_horizon_s = 6.0;   // [s]
+  double person_radius_m = 0.3;  // [m]
+  double lane_margin_m = 0.15;   // [m]
+  double lane_escape_deg = 60;   // [deg] from the lane's axis (90 = straight out sideways)
+  int sectors = 144;             // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
     b("robot_radius_m", robot_radius_m);
@@ -174,8 +174,8 @@ class ObstacleAvoider {
   /// from the axis [m], when the lane covers the robot; false otherwise.
   bool inLane(Eigen::Vector2d& normal, double& offset) const;
   void laneEscape(const std::vector<std::pair<double, double>>& pts, double target_bearing,
-                  double heading, double v_nominal, const Eigen::Vector2d& lane_n,
-                  double lane_off, AvoidOutput& out);
+                  double heading, double v_nominal, const Eigen::Vector2d& lane_n, double lane_off,
+                  AvoidOutput& out);
 };
 
 }  // namespace sketchnav::nav

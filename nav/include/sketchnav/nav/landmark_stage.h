@@ -41,6 +41,22 @@ struct Candidate {
 int selectCandidate(const std::vector<Candidate>& candidates, const std::string& class_name,
                     double predicted_bearing, double predicted_range, const SelectParams& p);
 
+/// Where the landmarks looked for this frame are expected, for handing out its detections.
+struct Expected {
+  std::string class_name;
+  bool tracked = false;  // seen within the last moments: expected where it was last seen
+  Polar where;           // from the robot (range 0 = unknown)
+};
+/// A landmark being tracked is expected where it was last seen (the ray from `origin` along
+/// `world_bearing` [rad, odometry frame], at `range` when > 0), not where the sketch puts it.
+Polar expectedFromTrack(const hw::Pose2D& robot, const Eigen::Vector2d& origin,
+                        double world_bearing, double range);
+/// Whether candidate `c` is the detection of a tracked landmark of the same class other than
+/// `self` (within 10 degrees and, with both ranges known, 0.75 m of where it is expected).
+/// The sketch can put a tracked landmark 25 degrees and a metre off: a repeated class's next
+/// landmark, sketched nearer, then took the tracked one's detection and was fixed 2 m off.
+bool claimedByTracked(const Candidate& c, size_t self, const std::vector<Expected>& expected);
+
 // Where a landmark is, from all its sightings. The laser range along a landmark's bearing is
 // the range to whatever the low laser plane hits there: a carton standing 0.2 m in front of a
 // bench face, seen at 17 degrees, is "seen" 0.65 m too far (the bench face behind it), and
