@@ -45,6 +45,21 @@ TEST(Movers, AWalkingPersonIsAMoverWithItsVelocity) {
   EXPECT_NEAR(m[0].position.y(), 2.0 - 0.4 * 3.0, 0.25);
 }
 
+TEST(Movers, WalkersForTheAvoiderAreTrackedForLongerAtAWalkingPace) {
+  LocalPlanner g1, g2, g3;
+  // 1 s after coming into view a mover, not yet a walker; after 2 s both.
+  const auto early = watch(g1, {0, 0, 0}, {3.0, 2.0}, {0.0, -0.4}, 1.0);
+  EXPECT_EQ(early.movers().size(), 1u);
+  EXPECT_TRUE(early.walkers().empty());
+  const auto later = watch(g2, {0, 0, 0}, {3.0, 2.0}, {0.0, -0.4}, 2.0);
+  ASSERT_EQ(later.walkers().size(), 1u);
+  EXPECT_NEAR(later.walkers()[0].velocity.y(), -0.4, 0.1);
+  // Faster than a walk (the phantoms sliding along walls went at 1.3-1.7 m/s): not a walker.
+  const auto fast = watch(g3, {0, 0, 0}, {3.0, 2.4}, {0.0, -1.6}, 2.5);
+  EXPECT_EQ(fast.movers().size(), 1u);
+  EXPECT_TRUE(fast.walkers().empty());
+}
+
 TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
   LocalPlanner grid;
   MoverParams on;

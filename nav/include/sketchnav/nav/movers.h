@@ -84,10 +84,11 @@ class MoverTracker {
   void update(const hw::Pose2D& robot, const hw::RangeScan& laser, const LocalPlanner& grid);
   /// Tracks moving faster than min_speed after min_updates scans.
   std::vector<Mover> movers() const;
-  /// The same, without requiring a track's first points to lie on floor seen free, but three
-  /// quarters of them: a person already walking when first in view (the lab's walker, seen
-  /// first across the room) is first seen where the grid had not yet seen the floor. For the
-  /// avoider, which acts only on one coming at the robot whose lane covers it.
+  /// People walking, for the avoider (which acts only on one coming at the robot whose lane
+  /// covers it): tracks followed for 3 x min_updates scans at 1.5 x min_speed to 1.2 m/s,
+  /// three quarters of their points on floor seen free; unlike movers(), the first need not
+  /// be: a person already walking when first in view (the lab's walker, seen first across
+  /// the room) is first seen where the grid had not yet seen the floor.
   std::vector<Mover> walkers() const;
   /// Advice for a robot at `robot` about to command (v, w): stop rather than enter a lane,
   /// step out of one it is in. `k_heading`, `v_max`: how it turns and how fast it may go.
