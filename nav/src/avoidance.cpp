@@ -51,6 +51,7 @@ void AvoidParams::validate() const {
   require(lane_margin_m >= 0, "nav.avoid.lane_margin_m", "must be >= 0 m");
   require(lane_escape_deg >= 0 && lane_escape_deg <= 85, "nav.avoid.lane_escape_deg",
           "must be in [0, 85]");
+  require(max_turn_rate > 0, "nav.avoid.max_turn_rate", "must be > 0 rad/s");
 }
 
 std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans) {
@@ -220,16 +221,27 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   };
   const Eigen::Vector2d u = walker_.vel.normalized();
   const Eigen::Vector2d perp(-u.y(), u.x());
-  // The side is chosen once per lane and kept: near the axis the estimate of which side the
-  // robot is on flips from scan to scan, and so would the robot.
+  // The side is chosen once per lane and kept (also when the lane lapses for a moment): near
+  // the axis the estimate of which side the robot is on flips from scan to scan, and so would
+  // the robot. Chosen by the sooner out: the turn to a steep enough direction plus the way
+  // sideways to clear the lane. By the side the robot is on alone, a robot 0.1 m off the axis
+  // facing south out of it turned round on the spot to leave northwards and was walked into
+  // while turning (exp4-pedestrian-left #3).
+  const double need = std::sin(P.lane_escape_deg * M_PI / 180);
   if (lane_sign_ == 0) {
-    if (lane_off >= 0.1)
-      lane_sign_ = lane_n.dot(perp) >= 0 ? 1 : -1;
-    else
-      lane_sign_ = (toRobot(perp).y() >= 0) == (side_ == DodgeSide::Left) ? 1 : -1;
+    const double clear = P.robot_radius_m + P.person_radius_m + P.lane_margin_m;
+    double best_t = 1e300;
+    for (const int sign : {1, -1}) {
+      const Eigen::Vector2d n = sign * perp, nr = toRobot(n);
+      const double turn = std::max(
+          0.0, std::abs(std::atan2(nr.y(), nr.x())) - (M_PI / 2 - P.lane_escape_deg * M_PI / 180));
+      const double side_off = lane_n.dot(n) >= 0 ? lane_off : -lane_off;
+      const double t =
+          turn / P.max_turn_rate + (clear - side_off) / (std::max(v_nominal, 0.05) * need);
+      if (t < best_t) best_t = t, lane_sign_ = sign;
+    }
   }
   const std::vector<Eigen::Vector2d> normals{lane_sign_ * perp, -lane_sign_ * perp};
-  const double need = std::sin(P.lane_escape_deg * M_PI / 180);
   auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= P.trigger_m; };
   bool found = false;
   double dir = 0;
@@ -257,6 +269,12 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
     }
   }
   side_ = toRobot(n_used).y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
+  fprintf(stderr,
+          "lane t %.2f off %.2f sign %d n %.2f %.2f found %d dir %.0f tb %.0f heading %.0f u "
+          "%.2f %.2f wpos %.2f %.2f robot %.2f %.2f\n",
+          prev_stamp_, lane_off, lane_sign_, n_used.x(), n_used.y(), found, dir * 57.3,
+          target_bearing * 57.3, heading * 57.3, u.x(), u.y(), walker_.pos.x(), walker_.pos.y(),
+          pose_.x, pose_.y);
   double v = 0;
   if (found) {
     v = v_nominal * std::max(0.0, std::cos(dir));
@@ -367,7 +385,8 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   const bool lane = inLane(lane_n, lane_off);
   out.in_lane = lane;
   if (lane) out.walker_pos = walker_.pos, out.walker_vel = walker_.vel;
-  if (!lane) lane_sign_ = 0;
+  if (lane) lane_t_ = now;
+  if (!lane && now - lane_t_ > 2.0) lane_sign_ = 0;
   const double trigger = std::min(P.trigger_m + moving * P.approach_horizon_s, P.max_range_m - 0.3);
   const double toward = std::clamp(target_bearing, -0.6, 0.6);
   const double target_free = corridorFree(pts, toward, hw, P.max_range_m);

@@ -56,6 +56,8 @@ struct AvoidParams {
   double person_radius_m = 0.3;  // [m]
   double lane_margin_m = 0.15;   // [m]
   double lane_escape_deg = 60;   // [deg] from the lane's axis (90 = straight out sideways)
+  double max_turn_rate = 0.8;    // [rad/s] how fast the base turns (nav.max_w), to choose the
+                                 // side out of a lane
   int sectors = 144;             // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
@@ -79,6 +81,7 @@ struct AvoidParams {
     b("person_radius_m", person_radius_m);
     b("lane_margin_m", lane_margin_m);
     b("lane_escape_deg", lane_escape_deg);
+    b("max_turn_rate", max_turn_rate);
     b("sectors", sectors);
   }
   void validate() const;  // InputError "nav.avoid.<field> = ...: ..."
@@ -168,7 +171,8 @@ class ObstacleAvoider {
     Eigen::Vector2d pos{0, 0}, vel{0, 0};
     double t = 0;
   } walker_;
-  int lane_sign_ = 0;  // side of the walker's axis the robot steps out to (+-1 x its left)
+  int lane_sign_ = 0;       // side of the walker's axis the robot steps out to (+-1 x its left)
+  double lane_t_ = -1e300;  // when a lane last covered the robot
   void followWalker(const std::vector<hw::RangeScan>& scans, double stamp, bool acquire);
   /// The unit normal from the walker's lane axis towards the robot, and the robot's offset
   /// from the axis [m], when the lane covers the robot; false otherwise.
