@@ -242,6 +242,25 @@ TEST(Avoider, StepsOutOfTheLaneOfAWalkerTheTrackerSawComingFromTheSide) {
   }
 }
 
+TEST(Avoider, LeavesALaneOnTheSideItFacesWhenNearTheAxis) {
+  // exp4-pedestrian-left #3: the robot stands 0.15 m north of a walker's axis, facing south,
+  // out of the lane; the walker comes west 2.5 m away. South is out sooner (no turn, 0.8 m
+  // sideways) than north (turning round, 0.5 m): it goes south, without turning round.
+  const hw::Pose2D pose{0, 0, -M_PI / 2};
+  const Eigen::Vector2d at(2.5, -0.15), vel(-0.4, 0.0);
+  ObstacleAvoider a;
+  a.setPose(pose);
+  a.step({test::scanAt(pose, {}, {{at.x(), at.y(), 0.25}}, 0.0)}, 0.0, DodgeSide::Left, pose.theta,
+         0.3, 0.0);
+  a.offerWalker(at, vel);
+  const auto out = a.step({test::scanAt(pose, {}, {{at.x() - 0.04, at.y(), 0.25}}, 0.1)}, 0.0,
+                          DodgeSide::Left, pose.theta, 0.3, 0.1);
+  ASSERT_TRUE(out.in_lane);
+  ASSERT_TRUE(out.active);
+  EXPECT_LE(std::abs(out.direction), 0.6);  // about the way it faces: south
+  EXPECT_GT(out.v, 0.1);
+}
+
 TEST(Avoider, TakesTheOtherSideWhenTheLandmarkSideIsClosed) {
   // Obstacle ahead, a wall 0.45 m to the left: dodging left is impossible.
   ObstacleAvoider a;
