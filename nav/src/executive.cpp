@@ -767,7 +767,9 @@ struct Executive::Impl {
         // approach estimate drops while the robot backs off and turns, and a plan through
         // the grid's picture of the person then led a robot straight into them.
         if (av.started) moving_seen = false;
-        moving_seen |= av.approach_speed >= 0.25;
+        // A walker's lane too: a detour planned on the grid ignores the lane, and one drove an
+        // exp4-pedestrian-left robot along it into the walker.
+        moving_seen |= av.approach_speed >= 0.25 || av.in_lane;
         double b = std::numeric_limits<double>::quiet_NaN();
         if (s.exec.detour && !moving_seen)
           b = planTowards(tracker.lookahead(pose, s.exec.detour_ahead_m));
