@@ -106,19 +106,13 @@ void ObstacleAvoider::reset() {
 void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, double stamp,
                                    bool acquire) {
   // Laser points only: a sonar cone says nothing of where in it the person is.
+  std::vector<hw::RangeScan> lasers;
+  for (const auto& sc : scans)
+    if (sc.kind == hw::RangeScan::Kind::Laser) lasers.push_back(sc);
   const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
   std::vector<Eigen::Vector2d> pts;
-  for (const auto& sc : scans) {
-    if (sc.kind != hw::RangeScan::Kind::Laser) continue;
-    const size_t n = std::min(sc.angles.size(), sc.ranges.size());
-    for (size_t i = 0; i < n; ++i) {
-      const double r = sc.ranges[i];
-      if (!std::isfinite(r) || r >= sc.max_range || r < sc.min_range) continue;
-      const double x = sc.mount.x + r * std::cos(sc.angles[i]);
-      const double y = sc.mount.y + r * std::sin(sc.angles[i]);
-      pts.emplace_back(pose_.x + c * x - sn * y, pose_.y + sn * x + c * y);
-    }
-  }
+  for (const auto& [x, y] : scanPoints(lasers))
+    pts.emplace_back(pose_.x + c * x - sn * y, pose_.y + sn * x + c * y);
   // The centre of the points within a person's reach of `p` (the side of them in view), when
   // they stand apart from anything else. A wall or a bench edge is not followed: a centre
   // slid along it by the predicted motion would keep its speed, a walker that never was.
@@ -205,6 +199,20 @@ double ObstacleAvoider::capSpeed(const std::vector<hw::RangeScan>& scans, double
   return v * std::max(k, 0.25 * (free > params_.min_clearance_m + 0.05));
 }
 
+double ObstacleAvoider::forwardSpeed(double dir, double v, AvoidOutput& out) const {
+  const auto& P = params_;
+  v *= std::max(0.0, std::cos(dir));
+  if (std::abs(dir) > 1.0) v = 0;  // turn first, then go
+  // Slow down as the corridor ahead closes, down to the minimum clearance.
+  v *=
+      std::clamp((out.front_free_m - P.min_clearance_m) / (P.slow_m - P.min_clearance_m), 0.0, 1.0);
+  if (out.front_free_m <= P.min_clearance_m) {
+    v = 0;
+    out.blocked = true;
+  }
+  return v;
+}
+
 void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& pts,
                                  double target_bearing, double heading, double v_nominal,
                                  const Eigen::Vector2d& lane_n, double lane_off, AvoidOutput& out) {
@@ -277,11 +285,7 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
           pose_.x, pose_.y);
   double v = 0;
   if (found) {
-    v = v_nominal * std::max(0.0, std::cos(dir));
-    if (std::abs(dir) > 1.0) v = 0;  // turn first, then go
-    v *= std::clamp((out.front_free_m - P.min_clearance_m) / (P.slow_m - P.min_clearance_m), 0.0,
-                    1.0);
-    if (out.front_free_m <= P.min_clearance_m) v = 0, out.blocked = true;
+    v = forwardSpeed(dir, v_nominal, out);
     prev_dir_odom_ = wrapAngle(heading + dir);
     have_prev_ = true;
   } else {
@@ -569,15 +573,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   }
   out.direction = dir;
   out.w = P.k_heading * dir;
-  double v = v_nominal * speed * std::max(0.0, std::cos(dir));
-  if (std::abs(dir) > 1.0) v = 0;  // turn first, then go
-  // Slow down as the corridor ahead closes, down to the minimum clearance.
-  v *=
-      std::clamp((out.front_free_m - P.min_clearance_m) / (P.slow_m - P.min_clearance_m), 0.0, 1.0);
-  if (out.front_free_m <= P.min_clearance_m) {
-    v = 0;
-    out.blocked = true;
-  }
+  double v = forwardSpeed(dir, v_nominal * speed, out);
   // Something keeps coming at us while we cannot go forward: back off (the way we came is
   // normally free) rather than wait to be walked into.
   if (moving > 0 && out.front_free_m <= P.min_clearance_m + 0.25 &&

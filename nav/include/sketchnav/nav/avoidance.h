@@ -177,6 +177,9 @@ class ObstacleAvoider {
   /// The unit normal from the walker's lane axis towards the robot, and the robot's offset
   /// from the axis [m], when the lane covers the robot; false otherwise.
   bool inLane(Eigen::Vector2d& normal, double& offset) const;
+  /// Forward speed along the heading for direction `dir`: turn first beyond 1 rad, slow as the
+  /// corridor ahead closes, none inside the minimum clearance (sets out.blocked).
+  double forwardSpeed(double dir, double v, AvoidOutput& out) const;
   void laneEscape(const std::vector<std::pair<double, double>>& pts, double target_bearing,
                   double heading, double v_nominal, const Eigen::Vector2d& lane_n, double lane_off,
                   AvoidOutput& out);
