@@ -10,6 +10,7 @@
 #include <fstream>
 #include <iomanip>
 #include <iostream>
+#include <map>
 #include <optional>
 #include <sstream>
 
@@ -23,6 +24,7 @@
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
+#include "sketchnav/nav/sections.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
@@ -504,6 +506,20 @@ Json runNavigation(const RunOptions& o) {
         d["goal_estimate_error_m"] = (g - w.goal.centre).norm();
         d["goal_estimate_world"] = {g.x(), g.y()};
       }
+      // The drawing's own share: where the same refit puts the goal with every sketched
+      // landmark fixed exactly (nav::goalFromExactFixes). A goal error near this one is the
+      // sketch's, not the robot's. The scale bound is loose: fit after fit, the navigation's
+      // scale may move that far too.
+      std::map<std::string, Eigen::Vector2d> truth;
+      for (const auto& l : w.landmarks) {
+        const Eigen::Vector2d dp(l.position.x() - w.start.x, l.position.y() - w.start.y);
+        truth[l.id] = {cs * dp.x() + ss * dp.y(), -ss * dp.x() + cs * dp.y()};
+      }
+      nav::WeightedFitParams wp;
+      wp.outlier_m = settings.exec.fit_outlier_m;
+      wp.max_scale_change = 0.5;
+      if (const auto g = nav::goalFromExactFixes(route, truth, wp))
+        d["sketch_goal_error_m"] = (toWorld(g->x(), g->y()) - w.goal.centre).norm();
       s["diagnostics"] = d;
     }
     s["render_s"] = simr->stats().render_seconds;

@@ -251,4 +251,26 @@ Polar polarFrom(const hw::Pose2D& pose, const Eigen::Vector2d& pt) {
   return {wrapAngle(std::atan2(d.y(), d.x()) - pose.theta), d.norm()};
 }
 
+std::optional<Eigen::Vector2d> goalFromExactFixes(
+    const mapsketch::Route& route, const std::map<std::string, Eigen::Vector2d>& truth,
+    const WeightedFitParams& p) {
+  if (route.sections.empty()) return std::nullopt;
+  // An exact observation: the fit's weight is then the sketch's error alone, the same for
+  // every landmark, as in the navigation's refit of well-located fixes.
+  const Eigen::Matrix2d exact = 1e12 * Eigen::Matrix2d::Identity();
+  std::vector<WeightedFix> fixes{{route.start_m, {0, 0}, exact, true}};
+  std::vector<std::string> seen;
+  for (const auto& sec : route.sections)
+    for (const auto& lm : sec.landmarks) {
+      const auto it = truth.find(lm.id);
+      if (it == truth.end() || std::find(seen.begin(), seen.end(), lm.id) != seen.end()) continue;
+      seen.push_back(lm.id);
+      fixes.push_back({lm.position_m, it->second, exact, false});
+    }
+  if (seen.size() < 2) return std::nullopt;
+  SectionTracker t(route);
+  if (!t.fitSimilarityWeighted(fixes, p).ok) return std::nullopt;
+  return t.toOdom(route.goal_m);
+}
+
 }  // namespace sketchnav::nav

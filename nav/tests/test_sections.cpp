@@ -364,3 +364,56 @@ TEST(SectionTracker, FitSimilarityWeightedNeedsTwoUsableFixes) {
   EXPECT_FALSE(t.fitSimilarityWeighted({start, unseen}, WeightedFitParams{}).ok);
   EXPECT_NEAR(t.scale(), 1.0, 1e-12);
 }
+
+namespace {
+using test::LmSpec;
+// Three landmarks along a route that turns at (10, 0) towards the goal (14, -4).
+mapsketch::Route threeLandmarkRoute(const Eigen::Vector2d& l3_drawn = {12.5, -1.0}) {
+  return makeRoute({{0, 0}, {10, 0}, {14, -4}},
+                   {{0, "A", "c", {3, 1}}, {0, "B", "c", {8, -1}}, {1, "C", "c", l3_drawn}});
+}
+// The world as the route's odometry frame sees it, turned and scaled against the drawing.
+Eigen::Vector2d world(const Eigen::Vector2d& p, double scale = 1.1, double rot = 0.2) {
+  return scale * Eigen::Vector2d(std::cos(rot) * p.x() - std::sin(rot) * p.y(),
+                                 std::sin(rot) * p.x() + std::cos(rot) * p.y());
+}
+}  // namespace
+
+TEST(GoalFromExactFixes, AnExactDrawingPutsTheGoalWhereItIsWhateverItsScaleAndTurn) {
+  const auto route = threeLandmarkRoute();
+  const std::map<std::string, Eigen::Vector2d> truth = {
+      {"A", world({3, 1})}, {"B", world({8, -1})}, {"C", world({12.5, -1})}};
+  const auto g = goalFromExactFixes(route, truth, WeightedFitParams{});
+  ASSERT_TRUE(g.has_value());
+  EXPECT_LT((*g - world({14, -4})).norm(), 1e-6);
+}
+
+TEST(GoalFromExactFixes, ALandmarkDrawnOffMovesTheGoalAndOnlyTheDrawingCounts) {
+  // C, nearest the goal, drawn 0.6 m off: the refit spreads that error, so the goal moves
+  // away from the truth, by less than C is off.
+  const auto route = threeLandmarkRoute({12.5, -0.4});
+  const std::map<std::string, Eigen::Vector2d> truth = {
+      {"A", world({3, 1}, 1, 0)}, {"B", world({8, -1}, 1, 0)}, {"C", world({12.5, -1}, 1, 0)}};
+  WeightedFitParams p;
+  p.outlier_m = 0;
+  const auto g = goalFromExactFixes(route, truth, p);
+  ASSERT_TRUE(g.has_value());
+  const double err = (*g - Eigen::Vector2d(14, -4)).norm();
+  EXPECT_GT(err, 0.05);
+  EXPECT_LT(err, 0.6);
+  // C was drawn north of its place: the refit turns the drawing clockwise to bring it down,
+  // and carries the drawn goal south of the true one.
+  EXPECT_LT(g->y(), -4.0);
+}
+
+TEST(GoalFromExactFixes, LandmarksWithoutATruthAreLeftOutAndTwoAreNeeded) {
+  const auto route = threeLandmarkRoute();
+  EXPECT_FALSE(goalFromExactFixes(route, {{"A", {3, 1}}}, WeightedFitParams{}).has_value());
+  EXPECT_FALSE(
+      goalFromExactFixes(route, {{"X", {3, 1}}, {"Y", {8, -1}}}, WeightedFitParams{}).has_value());
+  // A and B exact, C unknown (another world's id): still the exact goal.
+  const auto g =
+      goalFromExactFixes(route, {{"A", world({3, 1})}, {"B", world({8, -1})}}, WeightedFitParams{});
+  ASSERT_TRUE(g.has_value());
+  EXPECT_LT((*g - world({14, -4})).norm(), 1e-6);
+}

@@ -10,6 +10,9 @@
 #include <Eigen/Core>
 
 #include <cmath>
+#include <map>
+#include <optional>
+#include <string>
 #include <vector>
 
 #include "sketchnav/hw/types.h"
@@ -161,5 +164,16 @@ struct Polar {
   double bearing = 0, range = 0;
 };
 Polar polarFrom(const hw::Pose2D& pose, const Eigen::Vector2d& pt);
+
+/// Where the route puts its goal (odometry frame) when every sketched landmark is fixed
+/// exactly where it truly is: the navigation's refit (fitSimilarityWeighted, the start
+/// trusted at the odometry origin) to `truth` (landmark id -> true place, odometry frame);
+/// landmarks without a truth are left out. No perception or odometry can do better with
+/// this refit, so its distance to the true goal is the part of a goal error that the drawing
+/// alone makes (the experiments report it per trial). Empty with fewer than two landmarks
+/// known or a degenerate fit. `p.max_scale_change` bounds the scale against the route's own.
+std::optional<Eigen::Vector2d> goalFromExactFixes(
+    const mapsketch::Route& route, const std::map<std::string, Eigen::Vector2d>& truth,
+    const WeightedFitParams& p);
 
 }  // namespace sketchnav::nav
