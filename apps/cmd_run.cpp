@@ -1,4 +1,5 @@
 // sketchnav run: navigate: the simulated lab by default, or a real robot via device URIs.
+#include <cstdio>
 #include <iostream>
 
 #include "cli.h"
@@ -58,8 +59,28 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
               << summary["reason"].get<std::string>() << "\n"
               << "time " << summary["time_s"].get<double>() << " s (real-time factor "
               << summary["real_time_factor"].get<double>() << "), path "
-              << summary["path_length_m"].get<double>() << " m\n"
-              << "outputs in " << o.out_dir << "\n";
+              << summary["path_length_m"].get<double>() << " m\n";
+    // Simulation only: which part of a goal error is the robot's and which the drawing's.
+    if (summary.contains("diagnostics")) {
+      const Json& d = summary["diagnostics"];
+      char buf[200];
+      std::snprintf(buf, sizeof buf, "ground truth: odometry off %.2f m",
+                    d.value("odometry_error_m", 0.0));
+      std::cout << buf;
+      if (d.contains("goal_estimate_error_m")) {
+        std::snprintf(buf, sizeof buf, "; goal estimate off %.2f m",
+                      d["goal_estimate_error_m"].get<double>());
+        std::cout << buf;
+      }
+      if (d.contains("sketch_goal_error_m")) {
+        std::snprintf(buf, sizeof buf,
+                      "; the sketch alone puts the goal %.2f m off (every landmark fixed exactly)",
+                      d["sketch_goal_error_m"].get<double>());
+        std::cout << buf;
+      }
+      std::cout << "\n";
+    }
+    std::cout << "outputs in " << o.out_dir << "\n";
   }
   return summary["success"].get<bool>() ? 0 : 1;
 }

@@ -12,3 +12,10 @@ endforeach()
 add_test(NAME cli_exit_codes
   COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-work
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/exit_codes.cmake)
+# A simulated run says what ground truth shows: how far its odometry is off and how far the
+# sketch alone puts the goal (a failed, 3-second run: the exit code is not the point here).
+add_test(NAME cli_run_reports_ground_truth
+  COMMAND ${SN} run --max-time 3 --out ${CMAKE_CURRENT_BINARY_DIR}/cli-work/run-truth)
+set_tests_properties(cli_run_reports_ground_truth PROPERTIES
+  PASS_REGULAR_EXPRESSION "ground truth: odometry off [0-9.]+ m.*the sketch alone puts the goal [0-9.]+ m off"
+  TIMEOUT 300)
