@@ -22,6 +22,8 @@ void SectionParams::validate() const {
   require(end_slack_m >= 0 && end_slack_m < 5, "nav.sections.end_slack_m", "must be in [0, 5) m");
   require(goal_radius_m > 0 && goal_radius_m <= 5, "nav.sections.goal_radius_m",
           "must be in (0, 5] m");
+  require(goal_ahead_m >= 0 && goal_ahead_m <= goal_radius_m, "nav.sections.goal_ahead_m",
+          "must be in [0, goal_radius_m]");
   require(lookahead_m > 0.1 && lookahead_m < 10, "nav.sections.lookahead_m",
           "must be in (0.1, 10) m");
 }
@@ -202,6 +204,14 @@ int SectionTracker::update(const hw::Pose2D& o) {
     const double reach = last ? params_.goal_radius_m : params_.reach_radius_m;
     const bool crossed = !last && p.remaining_m <= params_.end_slack_m;
     if (p.to_end_m > reach && !crossed) break;
+    // At the goal, the robot drives on while the goal is still ahead of it: ending at the edge
+    // of goal_radius_m left every robot 0.15 m short of its own goal estimate (median over 84
+    // experiment trials), along the way it came, a bias on top of the sketch's error.
+    if (last) {
+      const Eigen::Vector2d to_goal = toOdom(section().end_m) - Eigen::Vector2d(o.x, o.y);
+      if (to_goal.dot(Eigen::Vector2d(std::cos(o.theta), std::sin(o.theta))) > params_.goal_ahead_m)
+        break;
+    }
     ++current_;
     ++n;
   }

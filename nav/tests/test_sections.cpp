@@ -38,11 +38,23 @@ TEST(SectionTracker, ProgressAndAdvance) {
   EXPECT_EQ(t.current(), 1);
   EXPECT_EQ(t.update({4.1, 1.0, 1.57}), 0);
   // The last section ends at the goal, a place: overshooting its line does not count (the
-  // robot turns back), being within goal_radius_m of it does.
+  // robot turns back), being within goal_radius_m of it does, once the goal is no longer
+  // ahead: a robot driving at the goal goes on to it instead of stopping 0.1 m short.
   EXPECT_EQ(t.update({4.0, 3.4, 1.57}), 0);
   EXPECT_EQ(t.update({4.4, 3.0, 1.57}), 0);
-  EXPECT_EQ(t.update({4.05, 3.1, -1.57}), 1);
+  EXPECT_EQ(t.update({4.05, 3.1, -1.57}), 0);
+  EXPECT_FALSE(t.finished());
+  EXPECT_EQ(t.update({4.02, 3.02, -1.57}), 1);
   EXPECT_TRUE(t.finished());
+  SectionTracker t3(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
+  t3.advance();
+  // Driving past the goal 0.1 m to its side: ends where the goal is abeam, not before.
+  EXPECT_EQ(t3.update({4.1, 2.88, 1.57}), 0);
+  EXPECT_EQ(t3.update({4.1, 2.99, 1.57}), 1);
+  SectionTracker t4(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
+  t4.advance();
+  // Facing away from it (after turning on the spot), within goal_radius_m: there already.
+  EXPECT_EQ(t4.update({4.0, 2.88, -1.57}), 1);
   SectionTracker t2(makeRoute({{0, 0}, {4, 0}, {4, 3}}));
   EXPECT_EQ(t2.update({3.95, 1.2, 0}), 1);  // 1.2 m off to the side but across the end line
 }

@@ -28,13 +28,16 @@ struct SectionParams {
                                  // point (perpendicular to it) to within this
   double goal_radius_m = 0.15;   // [m] the last section (the goal) ends only this close to its
                                  // end point (docking drives straight there, so it is reached;
-                                 // every cm here is one less for the sketch's own error)
+                                 // every cm here is one less for the sketch's own error)...
+  double goal_ahead_m = 0.03;    // [m] ...and once the goal is no more than this ahead of the
+                                 // robot: it stops on the goal, not on the circle round it
   double lookahead_m = 1.0;      // [m] pure-pursuit look-ahead along the remaining route
   template <class B>
   void bind(B& b) {
     b("reach_radius_m", reach_radius_m);
     b("end_slack_m", end_slack_m);
     b("goal_radius_m", goal_radius_m);
+    b("goal_ahead_m", goal_ahead_m);
     b("lookahead_m", lookahead_m);
   }
   void validate() const;  // InputError "nav.sections.<field> = ...: ..."
