@@ -60,6 +60,31 @@ TEST(Movers, WalkersForTheAvoiderAreTrackedForLongerAtAWalkingPace) {
   EXPECT_TRUE(fast.walkers().empty());
 }
 
+TEST(Movers, AWalkerWhoStoodWhereTheGridSawThemIsTakenOnceWalkingOnFreeFloor) {
+  // A person stands 3 s at (4, 1.5): the grid's snapshot holds that floor occupied. Then they
+  // walk towards the robot's side at 0.4 m/s over floor seen free. What counts is where the
+  // track has been lately, not the standing start (with the start counted, 30 of its first
+  // 50 points were on occupied floor and it was no walker 2 s after setting off).
+  LocalPlanner grid;
+  const hw::Pose2D robot{0, 0, 0};
+  auto boxes = room();
+  for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
+  MoverTracker tr(MoverParams{});
+  const Eigen::Vector2d stand(4.0, 1.5), vel(-0.4, 0.0);
+  for (double t = 0.5; t <= 3.5 + 1e-9; t += 0.1)
+    grid.insert(robot, scanAt(robot, boxes, {{stand.x(), stand.y(), 0.25}}, t));
+  const LocalPlanner before = grid.snapshot();  // the person standing, seen
+  for (double t = 0.5; t <= 3.5 + 1e-9; t += 0.1)
+    tr.update(robot, scanAt(robot, boxes, {{stand.x(), stand.y(), 0.25}}, t), before);
+  EXPECT_TRUE(tr.walkers().empty());  // standing: no walker
+  for (double t = 3.6; t <= 5.6 + 1e-9; t += 0.1) {
+    const Eigen::Vector2d p = stand + vel * (t - 3.5);
+    tr.update(robot, scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t), before);
+  }
+  ASSERT_EQ(tr.walkers().size(), 1u);
+  EXPECT_NEAR(tr.walkers()[0].velocity.x(), -0.4, 0.1);
+}
+
 TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
   LocalPlanner grid;
   MoverParams on;

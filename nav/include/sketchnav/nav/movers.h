@@ -13,6 +13,7 @@
 // sideways, away from the mover's line, rather than cross in front.
 #include <Eigen/Core>
 
+#include <cstdint>
 #include <vector>
 
 #include "sketchnav/hw/types.h"
@@ -101,8 +102,9 @@ class MoverTracker {
     Eigen::Vector2d pos{0, 0}, vel{0, 0};
     double t = 0;
     int updates = 0;
-    int free_hits = 0;       // updates whose points landed where the floor had been seen free
-    bool born_free = false;  // the first of them did
+    int free_hits = 0;            // updates whose points landed where the floor had been seen free
+    bool born_free = false;       // the first of them did
+    std::uint32_t free_bits = 0;  // the last 16 updates, newest lowest: on seen-free floor
     std::vector<std::pair<double, Eigen::Vector2d>> history;  // (stamp, centre), last 1.2 s
     Eigen::Vector2d fit_vel{0, 0};                            // straight-line fit over the history
     bool steady = false;                                      // and the fit is good (RMS <= 6 cm)
