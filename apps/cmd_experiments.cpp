@@ -30,13 +30,8 @@ struct VariantStats {
   // every landmark fixed exactly (summary diagnostics.sketch_goal_error_m) misses it.
   int sketch_limited = 0, sketch_known = 0;
   double time_sum = 0;
-  std::map<std::string, int> reasons;  // failure reasons, counted
+  std::vector<std::string> reasons;  // of the failed trials
 };
-
-std::string shortReason(const std::string& r) {
-  std::string s = r.substr(0, r.find(';'));
-  return s.size() > 70 ? s.substr(0, 67) + "..." : s;
-}
 
 void drawVariantFigure(const std::string& path, const Variant& v,
                        const std::vector<const ScenarioResult*>& trials) {
@@ -182,7 +177,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
         ++st.successes;
         st.time_sum += r.time_s;
       } else {
-        ++st.reasons[shortReason(r.reason)];
+        st.reasons.push_back(r.reason);
       }
     }
     const double rate = st.trials ? static_cast<double>(st.successes) / st.trials : 0.0;
@@ -192,18 +187,17 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
                   {"success_rate", rate},
                   {"mean_time_s", std::isfinite(mean_t) ? Json(mean_t) : Json(nullptr)},
                   {"sketch_limited", st.sketch_known ? Json(st.sketch_limited) : Json(nullptr)}};
-    std::string fails;
-    for (const auto& [why, n] : st.reasons)
-      fails += (fails.empty() ? "" : "; ") + std::to_string(n) + "x " + why;
     char buf[300];
     const std::string limited = st.sketch_known ? std::to_string(st.sketch_limited) : "-";
-    std::snprintf(buf, sizeof buf, "| %s | %d | %d | %.0f %% | %s | %s | %s |\n", v.name.c_str(),
+    // Built as a string: the failure list has no length limit (a fixed buffer cut a row of
+    // five failures, and the next row ran into it).
+    std::snprintf(buf, sizeof buf, "| %s | %d | %d | %.0f %% | %s | %s | ", v.name.c_str(),
                   st.trials, st.successes, 100 * rate,
                   std::isfinite(mean_t)
                       ? (std::to_string(static_cast<int>(std::lround(mean_t)))).c_str()
                       : "-",
-                  limited.c_str(), fails.c_str());
-    md << buf;
+                  limited.c_str());
+    md << buf << summariseFailures(st.reasons) << " |\n";
     std::snprintf(buf, sizeof buf, "%-25s %6d  %7d  %5.0f %%  %-13s  %s\n", v.name.c_str(),
                   st.trials, st.successes, 100 * rate,
                   std::isfinite(mean_t) ? std::to_string(mean_t).substr(0, 6).c_str() : "-",

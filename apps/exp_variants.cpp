@@ -1,6 +1,7 @@
 #include "exp_variants.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -279,6 +280,47 @@ void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
   const std::uint64_t variant_index = static_cast<std::uint64_t>(it - kNames.begin());
   const std::uint64_t noise_seed = static_cast<std::uint64_t>(seed) * 101 + variant_index;
   std::ofstream(path) << makeSketch(v, noise, noise_seed).dump(1) << "\n";
+}
+
+std::string summariseFailures(const std::vector<std::string>& reasons) {
+  struct Kind {
+    std::string key;  // first clause, figures replaced by "..."
+    int count = 0;
+    std::vector<std::string> figures;  // per trial, when its reason had any
+  };
+  std::vector<Kind> kinds;
+  auto isDigit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
+  for (const auto& r : reasons) {
+    const std::string head = r.substr(0, r.find(';'));
+    std::string key, figure, figures;
+    for (size_t i = 0; i <= head.size(); ++i) {
+      const char c = i < head.size() ? head[i] : '\0';
+      if (isDigit(c) ||
+          (c == '.' && !figure.empty() && i + 1 < head.size() && isDigit(head[i + 1]))) {
+        figure += c;
+        continue;
+      }
+      if (!figure.empty()) {
+        key += "...";
+        figures += (figures.empty() ? "" : " ") + figure;
+        figure.clear();
+      }
+      if (c) key += c;
+    }
+    auto it = std::find_if(kinds.begin(), kinds.end(), [&](const Kind& k) { return k.key == key; });
+    if (it == kinds.end()) it = kinds.insert(kinds.end(), Kind{key, 0, {}});
+    ++it->count;
+    if (!figures.empty()) it->figures.push_back(figures);
+  }
+  std::string out;
+  for (const auto& k : kinds) {
+    out += (out.empty() ? "" : "; ") + std::to_string(k.count) + "x " + k.key;
+    if (k.figures.empty()) continue;
+    out += " (";
+    for (size_t i = 0; i < k.figures.size(); ++i) out += (i ? ", " : "") + k.figures[i];
+    out += ")";
+  }
+  return out;
 }
 
 std::string writeBatchConfig(const Config& config, const std::string& out) {

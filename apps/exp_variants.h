@@ -64,6 +64,11 @@ std::string writeVariantWorld(const Variant& v, const std::string& dir);
 void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
                         const std::string& path);
 
+/// The report's failure column: reasons counted after their first clause, with the figures in
+/// them gathered so that trials differing only by a distance count together, e.g.
+/// "2x route completed but the robot stopped ... m from the goal (0.52, 0.68)".
+std::string summariseFailures(const std::vector<std::string>& reasons);
+
 /// Writes the run's --config/--set settings to <out>/config.json for the child runs; returns
 /// its path, or "" when there are none.
 std::string writeBatchConfig(const Config& config, const std::string& out);

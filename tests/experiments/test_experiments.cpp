@@ -137,3 +137,19 @@ TEST(Plot, DrawsAxesAndSeries) {
 
 }  // namespace
 }  // namespace sketchnav::app
+
+TEST(ExperimentsReport, FailuresCountTogetherWhenOnlyTheirFiguresDiffer) {
+  const std::vector<std::string> reasons = {
+      "route completed but the robot stopped 0.61 m from the goal",
+      "collision with pedestrian left; safety stop: base link lost",
+      "route completed but the robot stopped 0.82 m from the goal",
+      "collision with pedestrian left; safety stop: base link lost",
+      "route completed but the robot stopped 0.6 m from the goal"};
+  EXPECT_EQ(sketchnav::app::summariseFailures(reasons),
+            "3x route completed but the robot stopped ... m from the goal (0.61, 0.82, 0.6); "
+            "2x collision with pedestrian left");
+  // Five long reasons are not cut (the report's row once was, at 300 characters).
+  std::vector<std::string> many(5, std::string(120, 'x'));
+  EXPECT_EQ(sketchnav::app::summariseFailures(many), "5x " + std::string(120, 'x'));
+  EXPECT_EQ(sketchnav::app::summariseFailures({}), "");
+}
