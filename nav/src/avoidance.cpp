@@ -277,12 +277,6 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
     }
   }
   side_ = toRobot(n_used).y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
-  fprintf(stderr,
-          "lane t %.2f off %.2f sign %d n %.2f %.2f found %d dir %.0f tb %.0f heading %.0f u "
-          "%.2f %.2f wpos %.2f %.2f robot %.2f %.2f\n",
-          prev_stamp_, lane_off, lane_sign_, n_used.x(), n_used.y(), found, dir * 57.3,
-          target_bearing * 57.3, heading * 57.3, u.x(), u.y(), walker_.pos.x(), walker_.pos.y(),
-          pose_.x, pose_.y);
   double v = 0;
   if (found) {
     v = forwardSpeed(dir, v_nominal, out);
