@@ -54,9 +54,11 @@ void AvoidParams::validate() const {
   require(max_turn_rate > 0, "nav.avoid.max_turn_rate", "must be > 0 rad/s");
 }
 
-std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans) {
+std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans,
+                                                  bool lasers_only) {
   std::vector<std::pair<double, double>> pts;
   for (const auto& s : scans) {
+    if (lasers_only && s.kind != hw::RangeScan::Kind::Laser) continue;
     const size_t n = std::min(s.angles.size(), s.ranges.size());
     for (size_t i = 0; i < n; ++i) {
       const double r = s.ranges[i];
@@ -106,12 +108,9 @@ void ObstacleAvoider::reset() {
 void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, double stamp,
                                    bool acquire) {
   // Laser points only: a sonar cone says nothing of where in it the person is.
-  std::vector<hw::RangeScan> lasers;
-  for (const auto& sc : scans)
-    if (sc.kind == hw::RangeScan::Kind::Laser) lasers.push_back(sc);
   const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
   std::vector<Eigen::Vector2d> pts;
-  for (const auto& [x, y] : scanPoints(lasers))
+  for (const auto& [x, y] : scanPoints(scans, true))
     pts.emplace_back(pose_.x + c * x - sn * y, pose_.y + sn * x + c * y);
   // The centre of the points within a person's reach of `p` (the side of them in view), when
   // they stand apart from anything else. A wall or a bench edge is not followed: a centre

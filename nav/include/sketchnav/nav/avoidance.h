@@ -89,7 +89,9 @@ struct AvoidParams {
 
 /// Obstacle points in the robot frame [m] from laser / sonar scans (readings at or beyond
 /// max_range dropped; a sonar reading becomes three points across its cone, conservatively).
-std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans);
+/// `lasers_only`: sonar scans skipped (where in its cone a sonar echo lies is unknown).
+std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans,
+                                                  bool lasers_only = false);
 
 /// Free length [m] of a straight corridor of half-width `half_width` from the robot along
 /// `direction` [rad, robot frame] (max_len when nothing is in it).
