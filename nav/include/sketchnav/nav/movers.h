@@ -87,8 +87,8 @@ class MoverTracker {
   std::vector<Mover> movers() const;
   /// People walking, for the avoider (which acts only on one coming at the robot whose lane
   /// covers it): tracks followed for 3 x min_updates scans at 1.5 x min_speed to 1.2 m/s,
-  /// three quarters of their points on floor seen free; unlike movers(), the first need not
-  /// be: a person already walking when first in view (the lab's walker, seen first across
+  /// three quarters of their last 16 points on floor seen free; unlike movers(), the first
+  /// need not be: a person already walking when first in view (the lab's walker, seen first across
   /// the room) is first seen where the grid had not yet seen the floor.
   std::vector<Mover> walkers() const;
   /// Advice for a robot at `robot` about to command (v, w): stop rather than enter a lane,
