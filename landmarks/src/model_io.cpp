@@ -9,6 +9,7 @@
 //            keypoint colours (N x 3 u8, since version 3), words, colour thumbnail (H x 3W u8,
 //            since version 5).
 // Working descriptors (RootSIFT) and histograms are recomputed on load: they are derived.
+#include <Eigen/Core>
 #include <opencv2/flann.hpp>
 // After flann.hpp, which it needs (cvflann::seed_random).
 #include <opencv2/flann/random.h>
@@ -144,18 +145,60 @@ void LandmarkModel::finalise() {
 }
 
 void LandmarkModel::knn2(int photo, const cv::Mat& query, cv::Mat& indices, cv::Mat& dists) const {
-  // Exact brute force: for one photo's ~500 descriptors OpenCV's SIMD batch distance is
-  // faster than a FLANN kd-tree search (measured 2.6 vs 4.5 ms per photo) and never misses.
+  // Exact brute force: for one photo's ~500 descriptors a full distance table beats a FLANN
+  // kd-tree search (2.4 vs 4.5 ms per photo with cv::batchDistance) and never misses. The
+  // table is one matrix product, |q - t|^2 = |q|^2 + |t|^2 - 2 q.t, which Eigen's GEMM kernel
+  // computes in 1.5 ms (400 x 600 descriptors, one core, the distribution's SSE2 baseline);
+  // the neighbours are the same up to float rounding on exact ties.
   const cv::Mat& train = photos_[photo].descriptors;
   indices.create(query.rows, 2, CV_32S);
   dists.create(query.rows, 2, CV_32F);
   indices.setTo(-1);
   dists.setTo(std::numeric_limits<float>::max());
   if (query.empty() || train.rows < 1) return;
-  cv::Mat d, nn;
-  cv::batchDistance(query, train, d, CV_32F, nn, cv::NORM_L2SQR, std::min(2, train.rows));
-  d.copyTo(dists.colRange(0, d.cols));
-  nn.copyTo(indices.colRange(0, nn.cols));
+  if (query.type() != CV_32F || train.type() != CV_32F || query.cols != train.cols) {
+    cv::Mat d, nn;
+    cv::batchDistance(query, train, d, CV_32F, nn, cv::NORM_L2SQR, std::min(2, train.rows));
+    d.copyTo(dists.colRange(0, d.cols));
+    nn.copyTo(indices.colRange(0, nn.cols));
+    return;
+  }
+  using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  using View = Eigen::Map<const RowMajor, 0, Eigen::OuterStride<>>;
+  const View T(train.ptr<float>(), train.rows, train.cols,
+               Eigen::OuterStride<>(static_cast<Eigen::Index>(train.step1())));
+  const Eigen::VectorXf tn = T.rowwise().squaredNorm();
+  // Query rows in blocks: the product block stays in cache and its buffer is reused.
+  constexpr int kBlock = 64;
+  thread_local std::vector<float> buffer;
+  buffer.resize(static_cast<size_t>(kBlock) * train.rows);
+  for (int r0 = 0; r0 < query.rows; r0 += kBlock) {
+    const int rows = std::min(kBlock, query.rows - r0);
+    const View Q(query.ptr<float>(r0), rows, query.cols,
+                 Eigen::OuterStride<>(static_cast<Eigen::Index>(query.step1())));
+    Eigen::Map<RowMajor> G(buffer.data(), rows, train.rows);
+    G.noalias() = Q * T.transpose();
+    for (int i = 0; i < rows; ++i) {
+      const float qn = Q.row(i).squaredNorm();
+      const float* g = &G(i, 0);
+      float b1 = std::numeric_limits<float>::max(), b2 = b1;
+      int j1 = -1, j2 = -1;
+      for (int j = 0; j < train.rows; ++j) {
+        const float v = tn[j] - 2 * g[j];
+        if (v < b2) {
+          if (v < b1) {
+            b2 = b1, j2 = j1, b1 = v, j1 = j;
+          } else {
+            b2 = v, j2 = j;
+          }
+        }
+      }
+      int* id = indices.ptr<int>(r0 + i);
+      float* ds = dists.ptr<float>(r0 + i);
+      id[0] = j1, ds[0] = std::max(0.0f, qn + b1);
+      if (j2 >= 0) id[1] = j2, ds[1] = std::max(0.0f, qn + b2);
+    }
+  }
 }
 
 void LandmarkModel::knnAll(const cv::Mat& query, int k, int checks, cv::Mat& indices,

@@ -358,6 +358,40 @@ TEST_F(TinyModel, KeypointColoursAreStoredPerDatabaseKeypoint) {
   }
 }
 
+// knn2 computes its distance table as a matrix product (|q|^2 + |t|^2 - 2 q.t): it must find
+// the neighbours an exact brute force finds, on working descriptors and on a query that is a
+// view into a larger matrix (recognise() passes window rows).
+TEST_F(TinyModel, PhotoNearestTwoAreTheBruteForceOnes) {
+  const int photo = 1;
+  const cv::Mat& train = model_->photos()[photo].descriptors;
+  ASSERT_GT(train.rows, 2);
+  // Queries: other photos' descriptors (near and far ones), every other row of a wider block.
+  cv::Mat all;
+  cv::vconcat(model_->photos()[0].descriptors, model_->photos()[2].descriptors, all);
+  cv::Mat wide(all.rows, 2 * all.cols, CV_32F, cv::Scalar(7));
+  all.copyTo(wide.colRange(0, all.cols));
+  const cv::Mat query = wide.colRange(0, all.cols).rowRange(0, all.rows - 1);
+  ASSERT_FALSE(query.isContinuous());
+  cv::Mat idx, d2, ref_d, ref_nn;
+  model_->knn2(photo, query, idx, d2);
+  cv::batchDistance(query, train, ref_d, CV_32F, ref_nn, cv::NORM_L2SQR, 2);
+  ASSERT_EQ(idx.rows, query.rows);
+  int same = 0;
+  for (int i = 0; i < query.rows; ++i) {
+    // Neighbours may only swap on a near tie, where float rounding decides.
+    for (int k = 0; k < 2; ++k) {
+      EXPECT_NEAR(d2.at<float>(i, k), ref_d.at<float>(i, k), 1e-4f * (1 + ref_d.at<float>(i, k)))
+          << "row " << i << " neighbour " << k;
+      const int j = idx.at<int>(i, k);
+      ASSERT_GE(j, 0);
+      EXPECT_NEAR(cv::norm(query.row(i), train.row(j), cv::NORM_L2SQR), ref_d.at<float>(i, k),
+                  1e-4f * (1 + ref_d.at<float>(i, k)));
+    }
+    same += idx.at<int>(i, 0) == ref_nn.at<int>(i, 0);
+  }
+  EXPECT_GE(same, query.rows - 2);
+}
+
 namespace {
 // The same artwork in other colours: L* kept, (a*, b*) negated, so SIFT (grey levels) sees
 // nearly the same image while every coloured region changes hue, as between sibling products.
