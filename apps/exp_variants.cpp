@@ -274,12 +274,15 @@ std::string writeVariantWorld(const Variant& v, const std::string& dir) {
   return path;
 }
 
-void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
-                        const std::string& path) {
+Json variantSketch(const Variant& v, const SketchNoise& noise, int seed) {
   const auto it = std::find(kNames.begin(), kNames.end(), v.name);
   const std::uint64_t variant_index = static_cast<std::uint64_t>(it - kNames.begin());
-  const std::uint64_t noise_seed = static_cast<std::uint64_t>(seed) * 101 + variant_index;
-  std::ofstream(path) << makeSketch(v, noise, noise_seed).dump(1) << "\n";
+  return makeSketch(v, noise, static_cast<std::uint64_t>(seed) * 101 + variant_index);
+}
+
+void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
+                        const std::string& path) {
+  std::ofstream(path) << variantSketch(v, noise, seed).dump(1) << "\n";
 }
 
 std::string summariseFailures(const std::vector<std::string>& reasons) {

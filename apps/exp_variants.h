@@ -58,9 +58,12 @@ SketchNoise sketchNoiseFrom(const Config& config);
 /// Writes the variant's world to <dir>/<name>.world.json (dir created); returns the path.
 std::string writeVariantWorld(const Variant& v, const std::string& dir);
 
-/// Writes a sketch of `v` for simulator seed `seed` to `path`. The variant's place in
-/// variantNames() is mixed into the noise seed, so variants do not share drawing errors and a
-/// trial's sketch is the same whichever variants are run with it (--variants a,b).
+/// The sketch of `v` for simulator seed `seed`. The variant's place in variantNames() is mixed
+/// into the noise seed, so variants do not share drawing errors and a trial's sketch is the
+/// same whichever variants are run with it (--variants a,b).
+Json variantSketch(const Variant& v, const SketchNoise& noise, int seed);
+
+/// Writes variantSketch(v, noise, seed) to `path`.
 void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
                         const std::string& path);
 

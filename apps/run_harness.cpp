@@ -247,6 +247,27 @@ void drawTrajectory(const std::string& path, const sim::World& world,
 
 }  // namespace
 
+std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Route& route,
+                                       double fit_outlier_m) {
+  // The landmarks' true places in the odometry frame (the robot starts at its origin, facing
+  // +x), the refit of nav::goalFromExactFixes, and its goal back in the world. The scale bound
+  // is loose: fit after fit, the navigation's scale may move that far too.
+  const double cs = std::cos(w.start.theta), ss = std::sin(w.start.theta);
+  std::map<std::string, Eigen::Vector2d> truth;
+  for (const auto& l : w.landmarks) {
+    const Eigen::Vector2d dp(l.position.x() - w.start.x, l.position.y() - w.start.y);
+    truth[l.id] = {cs * dp.x() + ss * dp.y(), -ss * dp.x() + cs * dp.y()};
+  }
+  nav::WeightedFitParams wp;
+  wp.outlier_m = fit_outlier_m;
+  wp.max_scale_change = 0.5;
+  const auto g = nav::goalFromExactFixes(route, truth, wp);
+  if (!g) return std::nullopt;
+  const Eigen::Vector2d gw(w.start.x + cs * g->x() - ss * g->y(),
+                           w.start.y + ss * g->x() + cs * g->y());
+  return (gw - w.goal.centre).norm();
+}
+
 Json runNavigation(const RunOptions& o) {
   using wall = std::chrono::steady_clock;
   hw::registerBuiltinDrivers();
@@ -506,20 +527,9 @@ Json runNavigation(const RunOptions& o) {
         d["goal_estimate_error_m"] = (g - w.goal.centre).norm();
         d["goal_estimate_world"] = {g.x(), g.y()};
       }
-      // The drawing's own share: where the same refit puts the goal with every sketched
-      // landmark fixed exactly (nav::goalFromExactFixes). A goal error near this one is the
-      // sketch's, not the robot's. The scale bound is loose: fit after fit, the navigation's
-      // scale may move that far too.
-      std::map<std::string, Eigen::Vector2d> truth;
-      for (const auto& l : w.landmarks) {
-        const Eigen::Vector2d dp(l.position.x() - w.start.x, l.position.y() - w.start.y);
-        truth[l.id] = {cs * dp.x() + ss * dp.y(), -ss * dp.x() + cs * dp.y()};
-      }
-      nav::WeightedFitParams wp;
-      wp.outlier_m = settings.exec.fit_outlier_m;
-      wp.max_scale_change = 0.5;
-      if (const auto g = nav::goalFromExactFixes(route, truth, wp))
-        d["sketch_goal_error_m"] = (toWorld(g->x(), g->y()) - w.goal.centre).norm();
+      // The drawing's own share: a goal error near this one is the sketch's, not the robot's.
+      if (const auto e = sketchGoalErrorM(w, route, settings.exec.fit_outlier_m))
+        d["sketch_goal_error_m"] = *e;
       s["diagnostics"] = d;
     }
     s["render_s"] = simr->stats().render_seconds;

@@ -5,12 +5,20 @@
 // writes summary.json, trajectory.png, events.jsonl and telemetry.csv.
 #include <functional>
 #include <memory>
+#include <optional>
 #include <string>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/perception.h"
+
+namespace sketchnav::sim {
+struct World;
+}
+namespace sketchnav::mapsketch {
+struct Route;
+}
 
 namespace sketchnav::app {
 
@@ -26,9 +34,9 @@ struct RunOptions {
   std::string out_dir;    // "" = write no files
   // Hardware: any of these set -> a real robot (each empty one is absent).
   std::string robot, camera, laser, sonar;
-  std::string record;  // non-empty: append every frame, odometry, scan and command to this
-                       // MRPT rawlog (images beside it), flushed per record
-  std::string replay;  // non-empty: run simulator-free on a recorded rawlog's devices
+  std::string record;    // non-empty: append every frame, odometry, scan and command to this
+                         // MRPT rawlog (images beside it), flushed per record
+  std::string replay;    // non-empty: run simulator-free on a recorded rawlog's devices
   Config config;         // --config / --set (nav.*, servo.*, sim.*, ...)
   bool progress = true;  // progress lines on stderr
   /// Wraps the camera (tests: drop it mid-run; `sketchnav ui`: show and capture its frames).
@@ -48,6 +56,14 @@ struct RunOptions {
 /// Runs one navigation. Returns the summary object (what summary.json holds). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.
 Json runNavigation(const RunOptions& options);
+
+/// How far the sketch alone puts the goal [m]: where the navigation's refit of `route`, with
+/// every sketched landmark fixed exactly where `w` has it (nav::goalFromExactFixes, outlier
+/// gate `fit_outlier_m`), maps the drawn goal, from the goal's centre. None when fewer than two
+/// sketched landmarks are in the world. Perfect perception and odometry cannot do better with
+/// this refit.
+std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Route& route,
+                                       double fit_outlier_m);
 
 /// The landmark model cache file for a landmark set folder (keyed by its content hash).
 std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir);
