@@ -523,6 +523,11 @@ struct Executive::Impl {
             expect[n].tracked
                 ? expectedFromTrack(pose, t.last_origin, t.last_world_bearing, t.last_point_range)
                 : att[n].pred;
+        // A track followed by its bearing alone says nothing of the range: the sketch's
+        // prediction still gates a measured one (else the first laser return along the bearing,
+        // an obstacle in front, would be taken for the landmark).
+        if (expect[n].tracked && expect[n].where.range <= 0)
+          expect[n].where.range = att[n].pred.range;
       }
       for (size_t n = 0; n < att.size() && status == RunStatus::Running; ++n) {
         auto& x = att[n];
@@ -539,7 +544,9 @@ struct Executive::Impl {
         if (ci < 0) continue;
         used[idx[ci]] = true;
         const auto& d = *cands[ci].detection;
-        const double range = cands[ci].range_m;
+        // Taken for its bearing alone when its measured range is another object's.
+        const bool range_dropped = !rangeAgrees(cands[ci].range_m, expect[n].where.range, s.select);
+        const double range = range_dropped ? 0.0 : cands[ci].range_m;
         LmTrack& t = *x.tr;
         if (t.state != LmState::Tracking)
           event({{"type", "landmark_seen"},
@@ -551,6 +558,7 @@ struct Executive::Impl {
                  {"range_m", range},
                  {"predicted_bearing_deg", x.pred.bearing * 180 / M_PI},
                  {"predicted_range_m", x.pred.range},
+                 {"range_dropped", range_dropped},
                  {"candidates", cands.size()},
                  {"attended_first", n == 0}});
         t.state = LmState::Tracking;

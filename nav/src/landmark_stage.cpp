@@ -19,6 +19,14 @@ void SelectParams::validate() const {
   require(range_gate_min_m >= 0, "nav.select.range_gate_min_m", "must be >= 0");
   require(bearing_sigma_deg > 0, "nav.select.bearing_sigma_deg", "must be > 0");
   require(range_sigma_m > 0, "nav.select.range_sigma_m", "must be > 0");
+  require(bearing_only_gate_deg >= 0 && bearing_only_gate_deg <= bearing_gate_deg,
+          "nav.select.bearing_only_gate_deg", "must be in [0, bearing_gate_deg]");
+}
+
+bool rangeAgrees(double measured_m, double predicted_m, const SelectParams& p) {
+  if (measured_m <= 0 || predicted_m <= 0) return true;
+  return std::abs(measured_m - predicted_m) <=
+         std::max(p.range_gate_min_m, p.range_gate_rel * predicted_m);
 }
 
 int selectCandidate(const std::vector<Candidate>& cands, const std::string& class_name, double pb,
@@ -33,9 +41,15 @@ int selectCandidate(const std::vector<Candidate>& cands, const std::string& clas
     if (db > p.bearing_gate_deg * deg) continue;
     double cost = db / (p.bearing_sigma_deg * deg);
     if (c.range_m > 0 && pr > 0) {
+      const double gate = std::max(p.range_gate_min_m, p.range_gate_rel * pr);
       const double dr = std::abs(c.range_m - pr);
-      if (dr > std::max(p.range_gate_min_m, p.range_gate_rel * pr)) continue;
-      cost += dr / p.range_sigma_m;
+      if (dr <= gate) {
+        cost += dr / p.range_sigma_m;
+      } else if (db <= p.bearing_only_gate_deg * deg) {
+        cost += gate / p.range_sigma_m;  // its bearing only (see SelectParams)
+      } else {
+        continue;
+      }
     }
     if (best < 0 || cost < best_cost - 1e-9 ||
         (std::abs(cost - best_cost) <= 1e-9 &&

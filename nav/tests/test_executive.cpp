@@ -22,7 +22,10 @@ struct Recorder : ExecutiveObserver {
   std::vector<nlohmann::json> events;
   double min_clearance = 1e9;
   FakeWorld* w = nullptr;
-  void onEvent(const nlohmann::json& e) override { events.push_back(e); }
+  void onEvent(const nlohmann::json& e) override {
+    events.push_back(e);
+    if (std::getenv("NAV_TEST_TRACE")) std::printf("%s\n", e.dump().c_str());
+  }
   void onTick(const TelemetryRow& r) override {
     min_clearance = std::min(min_clearance, w->clearance());
     if (std::getenv("NAV_TEST_TRACE") && static_cast<int>(r.t * 20) % 10 == 0)

@@ -121,9 +121,29 @@ TEST(SelectCandidate, RejectsDetectionsInconsistentWithTheSketch) {
   const Detection far = det("bin", -60), ok = det("bin", 0);
   SelectParams p;
   EXPECT_EQ(selectCandidate({{&far, 2.0}}, "bin", 0.0, 2.0, p), -1);
-  EXPECT_EQ(selectCandidate({{&ok, 9.0}}, "bin", 0.0, 2.0, p), -1);  // 7 m off in range
-  EXPECT_EQ(selectCandidate({{&ok, 0.0}}, "bin", 0.0, 2.0, p), 0);   // no range: bearing only
+  const Detection off = det("bin", 15);
+  EXPECT_EQ(selectCandidate({{&off, 9.0}}, "bin", 0.0, 2.0, p), -1);  // 7 m off, 15 deg off
+  EXPECT_EQ(selectCandidate({{&ok, 0.0}}, "bin", 0.0, 2.0, p), 0);    // no range: bearing only
   EXPECT_EQ(selectCandidate({{&ok, 2.0}}, "cup", 0.0, 2.0, p), -1);
+}
+
+TEST(SelectCandidate, ALaserRangePastTheLandmarkLeavesItsBearing) {
+  // The laser passes beside a landmark on a shelf and reads the wall behind it: at the
+  // predicted bearing the detection is still the landmark, taken without that range.
+  const Detection ok = det("bin", 6);
+  SelectParams p;
+  EXPECT_EQ(selectCandidate({{&ok, 7.5}}, "bin", 10 * M_PI / 180, 4.6, p), 0);
+  EXPECT_FALSE(rangeAgrees(7.5, 4.6, p));  // the caller drops the range
+  EXPECT_TRUE(rangeAgrees(6.0, 4.6, p));
+  EXPECT_TRUE(rangeAgrees(0.0, 4.6, p));
+  // A detection whose range agrees wins over one at the exact bearing whose range does not.
+  const Detection exact = det("bin", 10), near = det("bin", 14);
+  EXPECT_EQ(selectCandidate({{&exact, 9.0}, {&near, 4.4}}, "bin", 10 * M_PI / 180, 4.6, p), 1);
+  // Off: the old rule refuses it.
+  p.bearing_only_gate_deg = 0;
+  EXPECT_EQ(selectCandidate({{&ok, 7.5}}, "bin", 10 * M_PI / 180, 4.6, p), -1);
+  p.bearing_only_gate_deg = 50;  // wider than the bearing gate
+  EXPECT_THROW(p.validate(), InputError);
 }
 
 TEST(SelectCandidate, ATrackedLandmarkKeepsItsDetection) {
