@@ -539,13 +539,16 @@ struct Executive::Impl {
           if (!used[c] && !atEarlierFix(x.lm->class_name, *all[c].detection, all[c].range_m) &&
               !claimedByTracked(all[c], n, expect))
             cands.push_back(all[c]), idx.push_back(c);
+        SelectParams sp = s.select;
+        if (sp.unique_class_bearing_only && classCount(x.lm->class_name) == 1)
+          sp.bearing_only_gate_deg = sp.bearing_gate_deg;
         const int ci = selectCandidate(cands, x.lm->class_name, expect[n].where.bearing,
-                                       expect[n].where.range, s.select);
+                                       expect[n].where.range, sp);
         if (ci < 0) continue;
         used[idx[ci]] = true;
         const auto& d = *cands[ci].detection;
         // Taken for its bearing alone when its measured range is another object's.
-        const bool range_dropped = !rangeAgrees(cands[ci].range_m, expect[n].where.range, s.select);
+        const bool range_dropped = !rangeAgrees(cands[ci].range_m, expect[n].where.range, sp);
         const double range = range_dropped ? 0.0 : cands[ci].range_m;
         LmTrack& t = *x.tr;
         if (t.state != LmState::Tracking)
@@ -1008,6 +1011,14 @@ struct Executive::Impl {
   // Sightings further than this are not ranged fixes (the laser along the bearing may hit
   // something else that far out).
   double fixRange() const { return s.exec.max_approach_m + 1.5; }
+
+  // How many landmarks of the sketch have this class.
+  int classCount(const std::string& cls) const {
+    int n = 0;
+    for (const auto& sec : tracker.route().sections)
+      for (const auto& l : sec.landmarks) n += l.class_name == cls;
+    return n;
+  }
 
   // Range at which a servoed landmark counts as passed: its lateral distance from the path,
   // or, for a landmark ahead beyond the section's end (on the wall the route turns at), its

@@ -120,6 +120,36 @@ TEST(Executive, AvoidsAStaticObstacleOnThePath) {
   EXPECT_LT(s.distToGoal(), 0.6);
 }
 
+// Landmark B drawn 4 m short of where it stands (2.5 m up the second section instead of 1.5 m
+// past its end): seen about 16 deg from where the sketch puts it, at three times the predicted
+// range, so its range never agrees. B's class is drawn once, so its detection is taken for its
+// bearing (SelectParams::unique_class_bearing_only); with that off every one is refused and
+// B is missed.
+void farDrawnBin(Scenario& s) {
+  s.route = makeRoute({{0, 0}, {6, 0}, {6, 5}},
+                      {{0, "A", "cup", {7.0, 0.3}}, {1, "B", "bin", {6.8, 2.5}}});
+}
+
+TEST(Executive, AUniqueLandmarkDrawnFarOffIsTakenByItsBearing) {
+  Scenario s;
+  farDrawnBin(s);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  ASSERT_EQ(sum.landmarks.size(), 2u);
+  EXPECT_EQ(sum.landmarks[1].state, "passed");
+  EXPECT_EQ(s.rec.count("landmark_missed"), 0);
+  bool dropped = false;
+  for (const auto& e : s.rec.events)
+    if (e["type"] == "landmark_seen" && e["id"] == "B") dropped = e.value("range_dropped", false);
+  EXPECT_TRUE(dropped);
+
+  Scenario off;
+  farDrawnBin(off);
+  off.settings.select.unique_class_bearing_only = false;
+  off.run();
+  ASSERT_EQ(off.rec.count("landmark_missed"), 1);
+}
+
 // A landmark of the last section out of the camera's view all the way (90 deg left of the
 // goal): the robot turns to it at the goal and looks before arriving.
 void lookBesideTheGoal(Scenario& s) {
