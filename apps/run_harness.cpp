@@ -62,6 +62,18 @@ bool looksLikePath(const std::string& s) {
   return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
 }
 
+// Odometry frame <-> world frame in simulation: the odometry frame starts at the world's start
+// pose (origin there, +x along its heading).
+Eigen::Vector2d odomToWorld(const hw::Pose2D& start, const Eigen::Vector2d& o) {
+  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
+  return {start.x + cs * o.x() - ss * o.y(), start.y + ss * o.x() + cs * o.y()};
+}
+Eigen::Vector2d worldToOdom(const hw::Pose2D& start, const Eigen::Vector2d& p) {
+  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
+  const Eigen::Vector2d d(p.x() - start.x, p.y() - start.y);
+  return {cs * d.x() + ss * d.y(), -ss * d.x() + cs * d.y()};
+}
+
 // Route frame -> world frame for drawing: the route's start at the world start pose, facing
 // along the first section (the executive's initial alignment).
 struct RouteToWorld {
@@ -71,9 +83,7 @@ struct RouteToWorld {
   Eigen::Vector2d operator()(const Eigen::Vector2d& p) const {
     const Eigen::Vector2d d = p - route_start;
     const double a = rot, c = std::cos(a), s = std::sin(a);
-    const Eigen::Vector2d o(c * d.x() - s * d.y(), s * d.x() + c * d.y());  // odometry frame
-    const double cs = std::cos(start.theta), ss = std::sin(start.theta);
-    return {start.x + cs * o.x() - ss * o.y(), start.y + ss * o.x() + cs * o.y()};
+    return odomToWorld(start, {c * d.x() - s * d.y(), s * d.x() + c * d.y()});
   }
 };
 
@@ -252,20 +262,14 @@ std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Rou
   // The landmarks' true places in the odometry frame (the robot starts at its origin, facing
   // +x), the refit of nav::goalFromExactFixes, and its goal back in the world. The scale bound
   // is loose: fit after fit, the navigation's scale may move that far too.
-  const double cs = std::cos(w.start.theta), ss = std::sin(w.start.theta);
   std::map<std::string, Eigen::Vector2d> truth;
-  for (const auto& l : w.landmarks) {
-    const Eigen::Vector2d dp(l.position.x() - w.start.x, l.position.y() - w.start.y);
-    truth[l.id] = {cs * dp.x() + ss * dp.y(), -ss * dp.x() + cs * dp.y()};
-  }
+  for (const auto& l : w.landmarks) truth[l.id] = worldToOdom(w.start, l.position);
   nav::WeightedFitParams wp;
   wp.outlier_m = fit_outlier_m;
   wp.max_scale_change = 0.5;
   const auto g = nav::goalFromExactFixes(route, truth, wp);
   if (!g) return std::nullopt;
-  const Eigen::Vector2d gw(w.start.x + cs * g->x() - ss * g->y(),
-                           w.start.y + ss * g->x() + cs * g->y());
-  return (gw - w.goal.centre).norm();
+  return (odomToWorld(w.start, *g) - w.goal.centre).norm();
 }
 
 Json runNavigation(const RunOptions& o) {
@@ -513,17 +517,14 @@ Json runNavigation(const RunOptions& o) {
     // is roughly their sum, so a short stop shows which one to work on.
     if (!observer.odom.empty()) {
       const hw::Pose2D o = observer.odom.back();
-      const double cs = std::cos(w.start.theta), ss = std::sin(w.start.theta);
-      auto toWorld = [&](double x, double y) {
-        return Eigen::Vector2d(w.start.x + cs * x - ss * y, w.start.y + ss * x + cs * y);
-      };
       Json d;
       const hw::Pose2D& ot = observer.last_truth;
-      d["odometry_error_m"] = (toWorld(o.x, o.y) - Eigen::Vector2d(ot.x, ot.y)).norm();
+      d["odometry_error_m"] =
+          (odomToWorld(w.start, {o.x, o.y}) - Eigen::Vector2d(ot.x, ot.y)).norm();
       d["odometry_heading_error_deg"] =
           nav::wrapAngle(w.start.theta + o.theta - ot.theta) * 180.0 / M_PI;
       if (observer.goal_odom) {
-        const Eigen::Vector2d g = toWorld(observer.goal_odom->x(), observer.goal_odom->y());
+        const Eigen::Vector2d g = odomToWorld(w.start, *observer.goal_odom);
         d["goal_estimate_error_m"] = (g - w.goal.centre).norm();
         d["goal_estimate_world"] = {g.x(), g.y()};
       }

@@ -156,13 +156,8 @@ void LandmarkModel::knn2(int photo, const cv::Mat& query, cv::Mat& indices, cv::
   indices.setTo(-1);
   dists.setTo(std::numeric_limits<float>::max());
   if (query.empty() || train.rows < 1) return;
-  if (query.type() != CV_32F || train.type() != CV_32F || query.cols != train.cols) {
-    cv::Mat d, nn;
-    cv::batchDistance(query, train, d, CV_32F, nn, cv::NORM_L2SQR, std::min(2, train.rows));
-    d.copyTo(dists.colRange(0, d.cols));
-    nn.copyTo(indices.colRange(0, nn.cols));
-    return;
-  }
+  // Working descriptors on both sides (cv::batchDistance refused anything else too).
+  CV_Assert(query.type() == CV_32F && train.type() == CV_32F && query.cols == train.cols);
   using RowMajor = Eigen::Matrix<float, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
   using View = Eigen::Map<const RowMajor, 0, Eigen::OuterStride<>>;
   const View T(train.ptr<float>(), train.rows, train.cols,

@@ -23,10 +23,16 @@ void SelectParams::validate() const {
           "nav.select.bearing_only_gate_deg", "must be in [0, bearing_gate_deg]");
 }
 
+namespace {
+// The range gate's half-width around a predicted range [m].
+double rangeGate(double predicted_m, const SelectParams& p) {
+  return std::max(p.range_gate_min_m, p.range_gate_rel * predicted_m);
+}
+}  // namespace
+
 bool rangeAgrees(double measured_m, double predicted_m, const SelectParams& p) {
   if (measured_m <= 0 || predicted_m <= 0) return true;
-  return std::abs(measured_m - predicted_m) <=
-         std::max(p.range_gate_min_m, p.range_gate_rel * predicted_m);
+  return std::abs(measured_m - predicted_m) <= rangeGate(predicted_m, p);
 }
 
 int selectCandidate(const std::vector<Candidate>& cands, const std::string& class_name, double pb,
@@ -41,7 +47,7 @@ int selectCandidate(const std::vector<Candidate>& cands, const std::string& clas
     if (db > p.bearing_gate_deg * deg) continue;
     double cost = db / (p.bearing_sigma_deg * deg);
     if (c.range_m > 0 && pr > 0) {
-      const double gate = std::max(p.range_gate_min_m, p.range_gate_rel * pr);
+      const double gate = rangeGate(pr, p);
       const double dr = std::abs(c.range_m - pr);
       if (dr <= gate) {
         cost += dr / p.range_sigma_m;
