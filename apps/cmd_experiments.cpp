@@ -111,7 +111,8 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("model", "landmark model (.slm); default: the demo set's cached model")
       .option("ceiling",
               "sketches per variant for the sketch ceiling: the success rate perfect "
-              "perception and odometry would reach with these drawing errors (0 = skip)",
+              "perception and odometry would reach with these drawing errors from the "
+              "landmarks alone, without the goal doorway (0 = skip)",
               "2000")
       .option("max-time",
               "give up each trial after this many simulated seconds "
@@ -195,7 +196,13 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
      << "perception and odometry would still fail those with this refit). *Sketch ceiling*: the "
      << "same judged on " << ceiling_n << " sketches of the variant (the trials' first): the "
      << "success rate perfect perception and odometry would reach with these drawing errors "
-     << "and this refit.\n\n"
+     << "and this refit. "
+     << (noise.goal_doorway
+             ? "The sketches say the goal is the doorway in front of it (goal_place): a robot "
+               "that finds the door with its laser is not bound by either figure."
+             : "The sketches give the goal as a bare point (experiments.sketch.goal_doorway "
+               "off).")
+     << "\n\n"
      << "| variant | trials | successes | success rate | mean time [s] | sketch-limited | "
         "sketch ceiling | failures |\n"
      << "|---|---:|---:|---:|---:|---:|---:|---|\n";

@@ -35,7 +35,11 @@ void printTable(const Sketch& s, const Route& r, const std::string& file) {
             << " % (RMS, relative)\n"
             << "route     " << r.sections.size() << " sections, " << f1(r.total_length_m) << " m, "
             << r.guide_points_m.size() << " guide points from " << s.path.size()
-            << " drawn points\n\n";
+            << " drawn points\n";
+  if (r.goal_place.kind == mapsketch::GoalPlace::Kind::Doorway)
+    std::cout << "goal      a doorway: the robot stops " << f1(r.goal_place.standoff_m, "%.2f")
+              << " m in front of the opening its laser finds near the drawn goal\n";
+  std::cout << "\n";
   std::printf("%-4s %-27s %7s %8s %7s  %s\n", "sec", "from -> to [m]", "len[m]", "head[deg]",
               "turn", "landmarks (#order class id side range@along)");
   for (const auto& sec : r.sections) {
@@ -100,8 +104,16 @@ void drawPng(const Sketch& s, const Route& r, const std::string& path) {
   cv::putText(img, "start", P(s.start) + cv::Point(8, 18), font, 0.45, cv::Scalar(0, 120, 0), 1,
               cv::LINE_AA);
   cv::circle(img, P(s.goal), 13, cv::Scalar(0, 0, 200), 3, cv::LINE_AA);
-  cv::putText(img, "goal", P(s.goal) + cv::Point(8, 18), font, 0.45, cv::Scalar(0, 0, 170), 1,
-              cv::LINE_AA);
+  const std::string goal_label =
+      r.goal_place.kind == mapsketch::GoalPlace::Kind::Doorway
+          ? "goal: " + f1(r.goal_place.standoff_m, "%.1f") + " m before the door"
+          : std::string("goal");
+  // A long label by the right edge goes to the goal's left, so it stays on the picture.
+  const int label_w = cv::getTextSize(goal_label, font, 0.45, 1, nullptr).width;
+  const cv::Point goal_at =
+      P(s.goal) +
+      (P(s.goal).x + 8 + label_w > W - 4 ? cv::Point(-8 - label_w, 28) : cv::Point(8, 18));
+  cv::putText(img, goal_label, goal_at, font, 0.45, cv::Scalar(0, 0, 170), 1, cv::LINE_AA);
   for (size_t i = 0; i < r.guide_points_m.size(); ++i) {
     const cv::Point c = P(fromM(r.guide_points_m[i]));
     cv::circle(img, c, 9, cv::Scalar(255, 255, 255), cv::FILLED, cv::LINE_AA);

@@ -29,6 +29,10 @@ struct SketchNoise {
   double distance_round_m = 0.5;   // [m] people round distances
   double path_sigma_m = 0.15;      // [m] error of each guide-line corner
   double jitter_px = 1.0;          // [px] hand jitter of each drawn point
+  // A goal standing in front of an open door (within 1.5 m of its centre) is sketched as that
+  // doorway (mapsketch::GoalPlace), its standoff the distance rounded to 0.1 m: the paper's
+  // goal is "the right door in room B", and that is how a person says it. false: a point.
+  bool goal_doorway = true;
   template <class B>
   void bind(B& b) {
     b("landmark_sigma_m", landmark_sigma_m);
@@ -36,6 +40,7 @@ struct SketchNoise {
     b("distance_round_m", distance_round_m);
     b("path_sigma_m", path_sigma_m);
     b("jitter_px", jitter_px);
+    b("goal_doorway", goal_doorway);
   }
   void validate() const;
 };

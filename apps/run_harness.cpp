@@ -155,6 +155,10 @@ class RunObserver final : public nav::ExecutiveObserver {
             e.value("side", "");
     else if (type == "avoid_end")
       msg = "obstacle cleared";
+    else if (type == "goal_door")
+      msg = "goal doorway found (" + fmt(e.value("width_m", 0.0)) + " m wide): the goal moved " +
+            fmt(e.value("moved_m", 0.0)) + " m to " + fmt(e.value("standoff_m", 0.0)) +
+            " m in front of it";
     else if (type == "fault")
       msg = "FAULT: " + e.value("reason", "");
     else if (type == "arrived" || type == "failed")

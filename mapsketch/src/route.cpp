@@ -214,6 +214,7 @@ Route toRoute(const Sketch& sk, const RouteParams& params) {
   };
   route.start_m = toM(sk.start);
   route.goal_m = toM(sk.goal);
+  route.goal_place = sk.goal_place;
   for (int k : kept) {
     route.guide_points_m.push_back(toM(path[k]));
     route.guide_point_path_index.push_back(path_index[k]);

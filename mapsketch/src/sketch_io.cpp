@@ -110,7 +110,9 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     r.fail("format", "version " + std::to_string(s.format) +
                          " was written by a newer sketchnav (this one reads up to " +
                          std::to_string(kSketchFormat) + ")");
-  r.onlyKeys(j, "", {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal"});
+  r.onlyKeys(
+      j, "",
+      {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal", "goal_place"});
   if (j.contains("name")) s.name = r.string(j["name"], "name");
   if (j.contains("notes")) s.notes = r.string(j["notes"], "notes");
 
@@ -154,6 +156,20 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     s.path.push_back(r.point(path[i], "path[" + std::to_string(i) + "]"));
   s.start = r.point(r.member(j, "", "start"), "start");
   s.goal = r.point(r.member(j, "", "goal"), "goal");
+  if (j.contains("goal_place")) {
+    const Json& g = j["goal_place"];
+    r.object(g, "goal_place");
+    r.onlyKeys(g, "goal_place", {"kind", "standoff_m"});
+    const std::string kind = r.string(r.member(g, "goal_place", "kind"), "goal_place.kind");
+    if (kind == "doorway")
+      s.goal_place.kind = GoalPlace::Kind::Doorway;
+    else if (kind == "point")
+      s.goal_place.kind = GoalPlace::Kind::Point;
+    else
+      r.fail("goal_place.kind", "'" + kind + "' is not one of: point, doorway");
+    if (g.contains("standoff_m"))
+      s.goal_place.standoff_m = r.number(g["standoff_m"], "goal_place.standoff_m");
+  }
   validateSketch(s, origin);
   return s;
 }
@@ -216,6 +232,9 @@ void validateSketch(const Sketch& s, const std::string& origin) {
     if (!finite(p)) fail(name, "not a finite number");
     if (!inside(p)) fail(name, ptxt(p) + " is outside the canvas");
   }
+  const double standoff = s.goal_place.standoff_m;
+  if (!std::isfinite(standoff) || standoff < 0 || standoff > 3)
+    fail("goal_place.standoff_m", "= " + fmt(standoff) + ": must be in [0, 3] m");
   // A path that passes no landmark gives the robot nothing to look for: almost certainly the
   // path or the landmarks were drawn on the wrong part of the canvas.
   const double near = detail::nearDistancePx(s);
@@ -290,6 +309,8 @@ Json sketchToJson(const Sketch& s) {
   j["path"] = path;
   j["start"] = {s.start.x(), s.start.y()};
   j["goal"] = {s.goal.x(), s.goal.y()};
+  if (s.goal_place.kind == GoalPlace::Kind::Doorway)
+    j["goal_place"] = {{"kind", "doorway"}, {"standoff_m", s.goal_place.standoff_m}};
   return j;
 }
 
@@ -312,7 +333,9 @@ std::string sketchToText(const Sketch& s) {
   for (size_t i = 0; i < j["path"].size(); ++i)
     o << (i == 0 ? "\n    " : i % 8 == 0 ? ",\n    " : ", ") << j["path"][i].dump();
   o << (j["path"].empty() ? "]" : "\n  ]") << ",\n  \"start\": " << j["start"].dump()
-    << ",\n  \"goal\": " << j["goal"].dump() << "\n}\n";
+    << ",\n  \"goal\": " << j["goal"].dump();
+  if (j.contains("goal_place")) o << ",\n  \"goal_place\": " << j["goal_place"].dump();
+  o << "\n}\n";
   return o.str();
 }
 
@@ -364,6 +387,8 @@ Json routeToJson(const Route& r) {
   j["total_length_m"] = r.total_length_m;
   j["start_m"] = pt(r.start_m);
   j["goal_m"] = pt(r.goal_m);
+  if (r.goal_place.kind == GoalPlace::Kind::Doorway)
+    j["goal_place"] = {{"kind", "doorway"}, {"standoff_m", r.goal_place.standoff_m}};
   j["start_heading_rad"] = r.start_heading_rad;
   Json gp = Json::array();
   for (const auto& p : r.guide_points_m) gp.push_back(pt(p));

@@ -69,6 +69,42 @@ TEST(SketchIo, SaveAndLoadAFile) {
   EXPECT_FALSE(fs::exists(p + ".tmp"));
 }
 
+TEST(SketchIo, AGoalDoorwayRoundTripsAndReachesTheRoute) {
+  Sketch a = fixtures::lSketch();
+  EXPECT_FALSE(sketchToJson(a).contains("goal_place")) << "a plain goal writes no goal_place";
+  a.goal_place.kind = GoalPlace::Kind::Doorway;
+  a.goal_place.standoff_m = 0.7;
+  const std::string text = sketchToText(a);
+  EXPECT_NE(text.find("\"goal_place\": {\"kind\":\"doorway\""), std::string::npos) << text;
+  const Sketch b = sketchFromText(text);
+  EXPECT_EQ(b.goal_place.kind, GoalPlace::Kind::Doorway);
+  EXPECT_DOUBLE_EQ(b.goal_place.standoff_m, 0.7);
+  const Route r = toRoute(b);
+  EXPECT_EQ(r.goal_place.kind, GoalPlace::Kind::Doorway);
+  EXPECT_DOUBLE_EQ(r.goal_place.standoff_m, 0.7);
+  EXPECT_EQ(routeToJson(r)["goal_place"]["kind"], "doorway");
+  // Without a standoff the default applies; "point" is the plain goal.
+  Json j = good();
+  j["goal_place"] = {{"kind", "doorway"}};
+  EXPECT_DOUBLE_EQ(sketchFromJson(j).goal_place.standoff_m, GoalPlace{}.standoff_m);
+  j["goal_place"] = {{"kind", "point"}};
+  EXPECT_EQ(sketchFromJson(j).goal_place.kind, GoalPlace::Kind::Point);
+}
+
+TEST(SketchValidation, ABadGoalPlaceNamesTheField) {
+  Json j = good();
+  j["goal_place"] = {{"kind", "window"}};
+  expectError(j, {"goal_place.kind", "'window'", "doorway"});
+  j["goal_place"] = {{"kind", "doorway"}, {"standoff_m", -0.2}};
+  expectError(j, {"goal_place.standoff_m", "[0, 3]"});
+  j["goal_place"] = {{"kind", "doorway"}, {"width", 1}};
+  expectError(j, {"goal_place.width", "unknown field"});
+  j["goal_place"] = "doorway";
+  expectError(j, {"goal_place", "expected an object"});
+  j["goal_place"] = Json::object();
+  expectError(j, {"goal_place.kind", "missing"});
+}
+
 TEST(SketchIo, PointsAsObjectsAreAccepted) {
   Json j = good();
   j["start"] = {{"x", 100}, {"y", 600}};
@@ -263,4 +299,7 @@ TEST(Examples, LabSketchFollowsThePapersRoute) {
   EXPECT_GT(r.scale_residual, 0.05);
   EXPECT_GT(r.total_length_m, 18);
   EXPECT_LT(r.total_length_m, 30);
+  // The paper's goal is the right door of room B: the robot stops 0.6 m in front of it.
+  EXPECT_EQ(r.goal_place.kind, GoalPlace::Kind::Doorway);
+  EXPECT_DOUBLE_EQ(r.goal_place.standoff_m, 0.6);
 }

@@ -75,6 +75,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.laser_odometry, c, "nav.laser_odometry");
   applyConfig(s.planner, c, "nav.planner");
   applyConfig(s.movers, c, "nav.movers");
+  applyConfig(s.goal_door, c, "nav.goal_door");
   applyConfig(s.servo, c, "servo");
   return s;
 }
@@ -220,6 +221,10 @@ struct Executive::Impl {
   // Across-ray unit normal of a bearing-only fix (placed only across its rays; its point
   // along them means nothing), zero for the others.
   std::vector<Eigen::Vector2d> fixes_across;
+  // Goal doorway (route goal_place): stopping points of the doorways seen near the goal
+  // (odometry frame, newest last), and whether the goal has been put on one.
+  std::vector<Eigen::Vector2d> door_stops;
+  bool door_fixed = false;
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -238,6 +243,7 @@ struct Executive::Impl {
     s.exec.validate();
     s.select.validate();
     s.locate.validate();
+    s.goal_door.validate();
     if (!dev.base || !dev.clock) throw std::logic_error("Executive: base and clock are required");
     if (!dev.camera) s.safety.require_camera = false, safety = SafetySupervisor(s.safety);
     if (dev.ranges.empty()) s.safety.require_range = false, safety = SafetySupervisor(s.safety);
@@ -348,6 +354,7 @@ struct Executive::Impl {
       for (size_t i : fresh) {
         movers.update(pose, scans[i], grid_before);
         planner.insert(pose, scans[i]);
+        lookForGoalDoor(scans[i]);
       }
       // The avoider follows walkers the tracker finds (avoidance.h), so the grid of a few
       // seconds ago is kept whenever the tracker runs.
@@ -658,7 +665,7 @@ struct Executive::Impl {
     // path planned on the grid leads there, or as near as the robot fits.
     bool docking = false;
     if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.dock_m && !dev.ranges.empty()) {
-      const Eigen::Vector2d goal = tracker.toOdom(sec.end_m);
+      const Eigen::Vector2d goal = tracker.endOdom(k);
       const Polar pg = polarFrom(pose, goal);
       const double free =
           corridorFree(scanPoints(scans), pg.bearing,
@@ -816,7 +823,7 @@ struct Executive::Impl {
         k + 1 == tracker.count() ? std::min(0.6, s.exec.end_blocked_m) : s.exec.end_blocked_m;
     if (dodging && prog.to_end_m <= blocked_m && !sectionBlocked_) {
       // Blocked means the range sensors see something at or before the end point itself.
-      const Polar pe = polarFrom(pose, tracker.toOdom(sec.end_m));
+      const Polar pe = polarFrom(pose, tracker.endOdom(k));
       const double r = rangeAt(pe.bearing);
       // For the goal, only an obstacle the robot could not stand next to the point for: a goal
       // half a metre from a wall is reachable and must be reached.
@@ -921,6 +928,52 @@ struct Executive::Impl {
       row.front_free_m = front;
       obs->onTick(row);
     }
+  }
+
+  // A doorway goal (mapsketch::GoalPlace): while the sketch's goal is within look_m, each laser
+  // scan's doorways whose stopping point lies within search_m of it are sightings; once
+  // min_scans of the recent ones agree within agree_m, their mean is the goal (and keeps being
+  // refined as the robot comes closer and sees the jambs better).
+  void lookForGoalDoor(const hw::RangeScan& sc) {
+    const auto& place = tracker.route().goal_place;
+    if (!s.goal_door.enabled || place.kind != mapsketch::GoalPlace::Kind::Doorway ||
+        sc.kind != hw::RangeScan::Kind::Laser || tracker.finished())
+      return;
+    const Eigen::Vector2d here(pose.x, pose.y);
+    const Eigen::Vector2d drawn = tracker.toOdom(tracker.route().goal_m);
+    if ((drawn - here).norm() > s.goal_door.look_m) return;
+    const Doorway* best = nullptr;
+    Eigen::Vector2d best_stop;
+    double best_d = s.goal_door.search_m;
+    const auto doors = findDoorways(sc, pose, s.goal_door);
+    for (const auto& d : doors) {
+      const Eigen::Vector2d stop = d.centre + place.standoff_m * d.normal;
+      const double dist = (stop - drawn).norm();
+      if (dist <= best_d) best = &d, best_d = dist, best_stop = stop;
+    }
+    if (!best) return;
+    door_stops.push_back(best_stop);
+    if (door_stops.size() > 30) door_stops.erase(door_stops.begin());
+    Eigen::Vector2d sum(0, 0);
+    int n = 0;
+    for (const auto& p : door_stops)
+      if ((p - best_stop).norm() <= s.goal_door.agree_m) sum += p, ++n;
+    if (n < s.goal_door.min_scans) return;
+    const Eigen::Vector2d goal = sum / n;
+    if (!door_fixed)
+      event({{"type", "goal_door"},
+             {"centre_odom", {best->centre.x(), best->centre.y()}},
+             {"width_m", best->width_m},
+             {"goal_odom", {goal.x(), goal.y()}},
+             {"moved_m", (goal - drawn).norm()},
+             {"standoff_m", place.standoff_m},
+             {"sightings", n}});
+    if (!door_fixed)
+      log::info("nav", "goal doorway found",
+                {{"width_m", std::to_string(best->width_m).substr(0, 4)},
+                 {"moved_m", std::to_string((goal - drawn).norm()).substr(0, 4)}});
+    door_fixed = true;
+    tracker.setGoalOdom(goal);
   }
 
   // Bearing [rad, robot frame] of the carrot on a path planned to `goal` (odometry frame),
@@ -1172,7 +1225,7 @@ struct Executive::Impl {
         if (status != RunStatus::Running) return;
       }
       // Where the (re-anchored) route put the end point, and the robot: for judging the sketch.
-      const Eigen::Vector2d end = tracker.toOdom(tracker.route().sections[k].end_m);
+      const Eigen::Vector2d end = tracker.endOdom(k);
       event({{"type", "section_done"},
              {"section", k},
              {"of", tracker.count()},

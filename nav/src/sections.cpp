@@ -181,7 +181,7 @@ SectionProgress SectionTracker::progress(const hw::Pose2D& o) const {
   SectionProgress p;
   if (finished()) return p;
   const auto& s = section();
-  const Eigen::Vector2d a = toOdom(s.start_m), b = toOdom(s.end_m), r(o.x, o.y);
+  const Eigen::Vector2d a = toOdom(s.start_m), b = endOdom(current_), r(o.x, o.y);
   Eigen::Vector2d d = b - a;
   const double len = d.norm();
   if (len > 1e-9) d /= len;
@@ -208,7 +208,7 @@ int SectionTracker::update(const hw::Pose2D& o) {
     // of goal_radius_m left every robot 0.15 m short of its own goal estimate (median over 84
     // experiment trials), along the way it came, a bias on top of the sketch's error.
     if (last) {
-      const Eigen::Vector2d to_goal = toOdom(section().end_m) - Eigen::Vector2d(o.x, o.y);
+      const Eigen::Vector2d to_goal = endOdom(current_) - Eigen::Vector2d(o.x, o.y);
       if (to_goal.dot(Eigen::Vector2d(std::cos(o.theta), std::sin(o.theta))) > params_.goal_ahead_m)
         break;
     }
@@ -225,7 +225,13 @@ void SectionTracker::advance() {
 std::vector<Eigen::Vector2d> SectionTracker::guidePointsOdom() const {
   std::vector<Eigen::Vector2d> out;
   for (const auto& g : route_.guide_points_m) out.push_back(toOdom(g));
+  if (goal_odom_ && !out.empty()) out.back() = *goal_odom_;
   return out;
+}
+
+Eigen::Vector2d SectionTracker::endOdom(int k) const {
+  if (k + 1 == count() && goal_odom_) return *goal_odom_;
+  return toOdom(route_.sections.at(k).end_m);
 }
 
 Eigen::Vector2d SectionTracker::lookahead(const hw::Pose2D& o) const {

@@ -5,6 +5,7 @@
 #include <Eigen/Core>
 #include <opencv2/core.hpp>
 
+#include <algorithm>
 #include <cmath>
 #include <memory>
 #include <stdexcept>
@@ -22,11 +23,16 @@ struct Circle {
   double r;
 };
 
+struct Wall {
+  Eigen::Vector2d a, b;  // a thin wall from a to b
+};
+
 struct FakeWorld {
   std::shared_ptr<hw::SimClock> clock = std::make_shared<hw::SimClock>();
   hw::Pose2D truth;  // world frame; odometry = truth (start frame = world frame here)
   double v = 0, w = 0, t = 0;
   std::vector<Circle> obstacles;
+  std::vector<Wall> walls;
   bool stopped_called = false;
   double last_stop_t = -1, last_motion_cmd_t = -1;
   bool link_ok = true;
@@ -45,6 +51,12 @@ struct FakeWorld {
     double m = 1e9;
     for (const auto& o : obstacles)
       m = std::min(m, (o.c - Eigen::Vector2d(truth.x, truth.y)).norm() - o.r - 0.2);
+    const Eigen::Vector2d p(truth.x, truth.y);
+    for (const auto& w : walls) {
+      const Eigen::Vector2d e = w.b - w.a;
+      const double u = std::clamp((p - w.a).dot(e) / e.squaredNorm(), 0.0, 1.0);
+      m = std::min(m, (w.a + u * e - p).norm() - 0.2);
+    }
     return m;
   }
 };
@@ -99,6 +111,14 @@ class FakeLaser final : public hw::RangeSensor {
         if (disc < 0) continue;
         const double tt = b - std::sqrt(disc);
         if (tt > 0) best = std::min(best, tt);
+      }
+      for (const auto& wl : w_.walls) {
+        const Eigen::Vector2d e = wl.b - wl.a, q = wl.a - o;
+        const double den = d.x() * e.y() - d.y() * e.x();
+        if (std::abs(den) < 1e-12) continue;
+        const double tt = (q.x() * e.y() - q.y() * e.x()) / den;
+        const double u = (q.x() * d.y() - q.y() * d.x()) / den;
+        if (tt > 0 && u >= 0 && u <= 1) best = std::min(best, tt);
       }
       s.angles.push_back(static_cast<float>(a));
       s.ranges.push_back(static_cast<float>(best));

@@ -243,3 +243,49 @@ TEST(Executive, StopsOnALostBaseLink) {
   EXPECT_EQ(s.world.v, 0.0);
   EXPECT_NEAR(s.world.last_stop_t, t, 1e-9);
 }
+
+// The goal is a doorway (mapsketch::GoalPlace): a wall y = 5.6 with a 1 m opening at
+// x 6.1-7.1, the goal 0.6 m in front of it at (6.6, 5.0), drawn at (6, 5), 0.6 m off. The
+// robot finds the opening with the laser near its goal estimate and stops in front of it;
+// with the search off it stops where the sketch says.
+void doorAtTheGoal(Scenario& s) {
+  s.route = makeRoute({{0, 0}, {6, 0}, {6, 5}},
+                      {{0, "A", "cup", {7.0, 0.3}}, {1, "B", "bin", {6.9, 2.6}}});
+  s.route.goal_place.kind = mapsketch::GoalPlace::Kind::Doorway;
+  s.route.goal_place.standoff_m = 0.6;
+  s.world.obstacles = {{{7.3, 0.5}, 0.15}, {{7.2, 2.8}, 0.15}};
+  s.world.walls = {{{2.0, 5.6}, {6.1, 5.6}}, {{7.1, 5.6}, {10.0, 5.6}}};
+  s.perception = std::make_unique<GeometricPerception>(
+      s.world, std::vector<TrueMark>{{"cup", {7.3, 0.5}}, {"bin", {7.2, 2.8}}});
+}
+
+TEST(Executive, StopsInFrontOfTheGoalDoorwayItSees) {
+  Scenario s;
+  doorAtTheGoal(s);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  ASSERT_EQ(s.rec.count("goal_door"), 1);
+  for (const auto& e : s.rec.events)
+    if (e["type"] == "goal_door") {
+      EXPECT_NEAR(e["width_m"].get<double>(), 1.0, 0.1);
+      EXPECT_GE(e["sightings"].get<int>(), s.settings.goal_door.min_scans);
+    }
+  const double off = std::hypot(s.world.truth.x - 6.6, s.world.truth.y - 5.0);
+  EXPECT_LT(off, 0.15);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+
+  Scenario blind;
+  doorAtTheGoal(blind);
+  blind.settings.goal_door.enabled = false;
+  EXPECT_EQ(blind.run().status, RunStatus::Succeeded);
+  EXPECT_EQ(blind.rec.count("goal_door"), 0);
+  EXPECT_GT(std::hypot(blind.world.truth.x - 6.6, blind.world.truth.y - 5.0), 0.3);
+}
+
+TEST(Executive, AGoalDrawnAsAPointIgnoresDoorways) {
+  Scenario s;
+  doorAtTheGoal(s);
+  s.route.goal_place = {};
+  s.run();
+  EXPECT_EQ(s.rec.count("goal_door"), 0);
+}

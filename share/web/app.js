@@ -12,6 +12,7 @@ const state = {
   path: [],             // [[x, y], ...]
   start: null, goal: null,
   startSet: false, goalSet: false,  // set by the user (otherwise they follow the path's ends)
+  goalDoor: null,       // the goal is a doorway: stop this many metres in front of it (null: a point)
 };
 let classes = [];          // [{name, thumbnail}]
 let selectedClass = null;  // palette selection
@@ -92,6 +93,7 @@ function toSketchJson() {
     path: state.path.map(([x, y]) => [r1(x), r1(y)]),
     start: (startPoint() || [0, 0]).map(r1),
     goal: (goalPoint() || [0, 0]).map(r1),
+    ...(state.goalDoor === null ? {} : { goal_place: { kind: 'doorway', standoff_m: state.goalDoor } }),
   };
 }
 
@@ -111,6 +113,8 @@ function fromSketchJson(j) {
   state.path = j.path.map((p) => [p[0], p[1]]);
   state.start = j.start; state.goal = j.goal;
   state.startSet = state.goalSet = true;
+  const gp = j.goal_place;
+  state.goalDoor = gp && gp.kind === 'doorway' ? (gp.standoff_m ?? 0.5) : null;
   selectedId = null;
 }
 
@@ -204,7 +208,7 @@ function renderMarks() {
   if (e) {
     el('circle', { class: 'mark-goal', cx: e[0], cy: e[1], r: 14 }, g);
     const t = el('text', { class: 'mark-label', x: e[0] + 16, y: e[1] + 22, fill: '#c62828' }, g);
-    t.textContent = 'goal';
+    t.textContent = state.goalDoor === null ? 'goal' : `goal: ${state.goalDoor} m before the door`;
   }
 }
 
@@ -263,6 +267,24 @@ function renderPanels() {
   }
   $('delete').disabled = !selectedId;
   $('add').disabled = !selectedClass;
+  $('goal-door').checked = state.goalDoor !== null;
+  $('goal-standoff').disabled = state.goalDoor === null;
+  if (state.goalDoor !== null && document.activeElement !== $('goal-standoff'))
+    $('goal-standoff').value = state.goalDoor;
+}
+
+// The goal as a doorway (doc/sketch-format.md, goal_place): the robot finds the opening with
+// its laser near the drawn goal and stops the given distance in front of it.
+function setGoalDoor() {
+  const on = $('goal-door').checked;
+  let v = Number($('goal-standoff').value);
+  if (!Number.isFinite(v)) v = 0.5;
+  v = Math.min(3, Math.max(0, Math.round(v * 10) / 10));
+  const next = on ? v : null;
+  if (next === state.goalDoor) return;
+  pushHistory();
+  state.goalDoor = next;
+  changed();
 }
 
 // ---------- live route ----------
@@ -496,7 +518,7 @@ async function save() {
 function newSketch() {
   if (dirty && !confirm('Discard the unsaved changes?')) return;
   pushHistory();
-  Object.assign(state, { name: '', landmarks: [], path: [], start: null, goal: null, startSet: false, goalSet: false });
+  Object.assign(state, { name: '', landmarks: [], path: [], start: null, goal: null, startSet: false, goalSet: false, goalDoor: null });
   setCanvasSize(1000, 700);
   selectedId = null;
   $('name').value = '';
@@ -547,6 +569,8 @@ function init() {
   $('delete').addEventListener('click', deleteSelected);
   $('clear-path').addEventListener('click', () => { if (!state.path.length) return; pushHistory(); state.path = []; changed(); });
   $('show-route').addEventListener('change', render);
+  $('goal-door').addEventListener('change', setGoalDoor);
+  $('goal-standoff').addEventListener('change', setGoalDoor);
   $('save').addEventListener('click', save);
   $('new').addEventListener('click', newSketch);
   $('open').addEventListener('change', (e) => { openSketch(e.target.value); e.target.value = ''; });

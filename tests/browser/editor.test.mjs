@@ -107,6 +107,11 @@ try {
   assert.ok(Math.abs(r1[0] + r1[2] / 2 - 300) < 4 && Math.abs(r1[1] + r1[3] / 2 - 470) < 4, `L1 moved: ${r1}`);
   assert.ok(Math.abs(r2[2] - 150) < 4 && Math.abs(r2[3] - 100) < 4, `L2 resized: ${r2}`);
 
+  // The goal is a door: stop 0.8 m in front of it.
+  await page.check('#goal-door');
+  await page.fill('#goal-standoff', '0.8');
+  await page.dispatchEvent('#goal-standoff', 'change');
+
   // 2. A wobbly guide path, drawn with the mouse like a person would.
   await page.click('#tool-path');
   const pts = [];
@@ -150,12 +155,14 @@ try {
   assert.ok(saved.path.length >= 40, `path has many points (${saved.path.length})`);
   assert.ok(Math.hypot(saved.start[0] - pts[0][0], saved.start[1] - pts[0][1]) < 3, `start ${saved.start} (drawn at ${pts[0]})`);
   assert.ok(Math.hypot(saved.goal[0] - 860, saved.goal[1] - 140) < 3, `goal ${saved.goal}`);
+  assert.deepEqual(saved.goal_place, { kind: 'doorway', standoff_m: 0.8 });
 
   // 5. The command line reads what the editor wrote.
   const route = JSON.parse(execFileSync(sketchnav, ['--json', 'route', file]).toString());
   const order = route.sections.flatMap((s) => s.landmarks.map((l) => l.id));
   assert.deepEqual(order, ['L1', 'L2']);
   assert.ok(route.sections.length >= 2);
+  assert.deepEqual(route.goal_place, { kind: 'doorway', standoff_m: 0.8 });
 
   // 6. Undo takes back the last edit (the save does not count), and the page had no errors.
   await page.click('#undo');

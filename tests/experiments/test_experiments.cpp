@@ -49,7 +49,17 @@ TEST(ExperimentVariants, EveryVariantLoadsAndRoutes) {
     // The robot is put down facing along the first stroke.
     const auto d0 = v.drawn_path[1] - v.drawn_path[0];
     EXPECT_NEAR(w.start.theta, std::atan2(d0.y(), d0.x()), 1e-6);
+    // The goal stands 0.6 m in front of room B's right door, and the sketch says so.
+    EXPECT_EQ(r.goal_place.kind, mapsketch::GoalPlace::Kind::Doorway);
+    EXPECT_DOUBLE_EQ(r.goal_place.standoff_m, 0.6);
   }
+  SketchNoise point;
+  point.goal_doorway = false;
+  EXPECT_FALSE(makeSketch(makeVariant("exp3-4"), point, 3).contains("goal_place"));
+  // A goal far from every door is a point whatever the setting.
+  Variant far = makeVariant("exp3-4");
+  far.world["doors"] = Json::array();
+  EXPECT_FALSE(makeSketch(far, SketchNoise{}, 3).contains("goal_place"));
 }
 
 TEST(ExperimentVariants, TransformationsAsDocumented) {

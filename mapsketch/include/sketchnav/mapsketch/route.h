@@ -45,6 +45,7 @@ struct Route {
   std::vector<PathSection> sections;
   std::vector<Eigen::Vector2d> guide_points_m;  // sections.size() + 1 points
   Eigen::Vector2d start_m{0, 0}, goal_m{0, 0};
+  GoalPlace goal_place;  // the sketch's: a doorway goal is looked for near goal_m
   double start_heading_rad = 0;
   double scale_m_per_px = 0;  // estimated from the user's distances (least squares)
   double scale_residual = 0;  // relative RMS residual of that fit (0 = consistent distances)

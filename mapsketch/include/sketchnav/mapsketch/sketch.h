@@ -22,6 +22,15 @@ struct SketchLandmark {
                            // route order (from the start for the first one)
 };
 
+/// What the goal is, beyond a point on the canvas. A doorway is a place the robot recognises
+/// by itself (the laser sees the opening), so the drawn goal only has to be near it: the robot
+/// stops `standoff_m` in front of the doorway it finds there (doc/sketch-format.md).
+struct GoalPlace {
+  enum class Kind { Point, Doorway };
+  Kind kind = Kind::Point;
+  double standoff_m = 0.5;  // [m] doorway: stop this far in front of the opening (0 = in it)
+};
+
 struct Sketch {
   int format = 1;
   double canvas_width = 1000, canvas_height = 700;  // [canvas px]
@@ -29,6 +38,7 @@ struct Sketch {
   std::vector<Eigen::Vector2d> path;  // the guide path as drawn, many jittery points [px]
   Eigen::Vector2d start{0, 0};        // [px]
   Eigen::Vector2d goal{0, 0};         // [px]
+  GoalPlace goal_place;               // optional in the file ("goal_place")
   std::string name;                   // free text
   std::string notes;                  // free text for people (e.g. how it was drawn); optional
 };

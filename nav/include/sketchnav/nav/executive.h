@@ -19,6 +19,7 @@
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/avoidance.h"
+#include "sketchnav/nav/doorway.h"
 #include "sketchnav/nav/landmark_stage.h"
 #include "sketchnav/nav/laser_odometry.h"
 #include "sketchnav/nav/local_planner.h"
@@ -194,13 +195,13 @@ struct NavSettings {
   LaserOdometryParams laser_odometry;
   PlannerParams planner;
   MoverParams movers;
+  GoalDoorParams goal_door;
   servo::TurnLawParams servo;
 };
 
 /// Loads every section from `config` ("nav.*", "nav.sections.*", "nav.select.*", "nav.locate.*",
 /// "nav.avoid.*", "nav.safety.*", "nav.laser_odometry.*", "nav.planner.*", "nav.movers.*",
-/// "servo.*") over the
-/// defaults and validates.
+/// "nav.goal_door.*", "servo.*") over the defaults and validates.
 NavSettings navSettingsFrom(const Config& config);
 
 /// One control tick, for telemetry.csv.

@@ -99,6 +99,14 @@ class SectionTracker {
   const mapsketch::PathSection& section() const;
 
   Eigen::Vector2d toOdom(const Eigen::Vector2d& route_pt) const;
+  /// The goal (the last section's end) as observed, odometry frame: the goal doorway the laser
+  /// found (doorway.h). It replaces where the alignment puts the goal for progress(),
+  /// update(), lookahead() and endOdom(); later refits no longer move it. nullopt: the
+  /// alignment's goal again.
+  void setGoalOdom(std::optional<Eigen::Vector2d> goal) { goal_odom_ = goal; }
+  const std::optional<Eigen::Vector2d>& goalOdom() const { return goal_odom_; }
+  /// Section k's end point, odometry frame (the observed goal for the last section).
+  Eigen::Vector2d endOdom(int k) const;
   Eigen::Vector2d toRoute(const Eigen::Vector2d& odom_pt) const;
   double headingToOdom(double route_heading) const;
   /// Shifts the alignment by `gain` (0..1) of the way so that `route_pt` maps to `odom_pt`.
@@ -160,6 +168,7 @@ class SectionTracker {
   double rot_ = 0;               // odom heading = route heading + rot_
   double scale_ = 1;             // odom metres per route metre
   Eigen::Vector2d trans_{0, 0};  // odom = scale_ R(rot_) (route - start) + trans_
+  std::optional<Eigen::Vector2d> goal_odom_;
 };
 
 /// Bearing [rad, CCW, robot frame] and range [m] of an odometry-frame point from a pose.
