@@ -23,6 +23,17 @@ struct Circle {
   double r;
 };
 
+/// Distance along the ray o + t d (d unit) to the segment a-b; infinity when it misses.
+inline double rayToSegment(const Eigen::Vector2d& o, const Eigen::Vector2d& d,
+                           const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
+  const Eigen::Vector2d e = b - a, q = a - o;
+  const double den = d.x() * e.y() - d.y() * e.x();
+  if (std::abs(den) < 1e-12) return INFINITY;
+  const double t = (q.x() * e.y() - q.y() * e.x()) / den;
+  const double u = (q.x() * d.y() - q.y() * d.x()) / den;
+  return t > 0 && u >= 0 && u <= 1 ? t : INFINITY;
+}
+
 struct Wall {
   Eigen::Vector2d a, b;  // a thin wall from a to b
 };
@@ -112,14 +123,7 @@ class FakeLaser final : public hw::RangeSensor {
         const double tt = b - std::sqrt(disc);
         if (tt > 0) best = std::min(best, tt);
       }
-      for (const auto& wl : w_.walls) {
-        const Eigen::Vector2d e = wl.b - wl.a, q = wl.a - o;
-        const double den = d.x() * e.y() - d.y() * e.x();
-        if (std::abs(den) < 1e-12) continue;
-        const double tt = (q.x() * e.y() - q.y() * e.x()) / den;
-        const double u = (q.x() * d.y() - q.y() * d.x()) / den;
-        if (tt > 0 && u >= 0 && u <= 1) best = std::min(best, tt);
-      }
+      for (const auto& wl : w_.walls) best = std::min(best, rayToSegment(o, d, wl.a, wl.b));
       s.angles.push_back(static_cast<float>(a));
       s.ranges.push_back(static_cast<float>(best));
     }

@@ -7,6 +7,7 @@
 #include <cmath>
 #include <random>
 
+#include "fake_world.h"
 #include "sketchnav/nav/doorway.h"
 
 using namespace sketchnav;
@@ -34,14 +35,7 @@ hw::RangeScan scanOf(const std::vector<Seg>& segs, const hw::Pose2D& pose, doubl
     const double a = i * M_PI / 180, g = pose.theta + a;
     const Eigen::Vector2d d(std::cos(g), std::sin(g));
     double best = 8.0;
-    for (const auto& sg : segs) {
-      const Eigen::Vector2d e = sg.b - sg.a, w = sg.a - o;
-      const double den = d.x() * e.y() - d.y() * e.x();
-      if (std::abs(den) < 1e-12) continue;
-      const double t = (w.x() * e.y() - w.y() * e.x()) / den;
-      const double u = (w.x() * d.y() - w.y() * d.x()) / den;
-      if (t > 0 && u >= 0 && u <= 1) best = std::min(best, t);
-    }
+    for (const auto& sg : segs) best = std::min(best, test::rayToSegment(o, d, sg.a, sg.b));
     if (best < 8.0 && noise > 0) best += n(rng);
     s.angles.push_back(static_cast<float>(a));
     s.ranges.push_back(static_cast<float>(best));
