@@ -23,6 +23,12 @@ const char* typeName(const Json& v) {
   return "an object";
 }
 
+// A goal place as the file writes it (the sketch's "goal_place", and the route's).
+Json goalPlaceJson(const GoalPlace& g) {
+  return {{"kind", g.kind == GoalPlace::Kind::Doorway ? "doorway" : "point"},
+          {"standoff_m", g.standoff_m}};
+}
+
 // Every reader names the field with its JSON path so a user can find it in the file.
 class Reader {
  public:
@@ -309,8 +315,7 @@ Json sketchToJson(const Sketch& s) {
   j["path"] = path;
   j["start"] = {s.start.x(), s.start.y()};
   j["goal"] = {s.goal.x(), s.goal.y()};
-  if (s.goal_place.kind == GoalPlace::Kind::Doorway)
-    j["goal_place"] = {{"kind", "doorway"}, {"standoff_m", s.goal_place.standoff_m}};
+  if (s.goal_place.kind == GoalPlace::Kind::Doorway) j["goal_place"] = goalPlaceJson(s.goal_place);
   return j;
 }
 
@@ -387,8 +392,7 @@ Json routeToJson(const Route& r) {
   j["total_length_m"] = r.total_length_m;
   j["start_m"] = pt(r.start_m);
   j["goal_m"] = pt(r.goal_m);
-  if (r.goal_place.kind == GoalPlace::Kind::Doorway)
-    j["goal_place"] = {{"kind", "doorway"}, {"standoff_m", r.goal_place.standoff_m}};
+  if (r.goal_place.kind == GoalPlace::Kind::Doorway) j["goal_place"] = goalPlaceJson(r.goal_place);
   j["start_heading_rad"] = r.start_heading_rad;
   Json gp = Json::array();
   for (const auto& p : r.guide_points_m) gp.push_back(pt(p));

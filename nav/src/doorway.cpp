@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 
 #include "sketchnav/core/config.h"
@@ -33,17 +34,16 @@ std::vector<Doorway> findDoorways(const hw::RangeScan& scan, const hw::Pose2D& p
                                   const DoorwayParams& p) {
   std::vector<Doorway> out;
   if (scan.kind != hw::RangeScan::Kind::Laser) return out;
-  const size_t n0 = std::min(scan.angles.size(), scan.ranges.size());
-  if (n0 < 3) return out;
+  const size_t n = std::min(scan.angles.size(), scan.ranges.size());
+  if (n < 3) return out;
   // Beams in angle order (drivers give them so, but nothing below may assume it).
-  std::vector<size_t> order(n0);
+  std::vector<size_t> order(n);
   std::iota(order.begin(), order.end(), 0);
   std::sort(order.begin(), order.end(),
             [&](size_t a, size_t b) { return scan.angles[a] < scan.angles[b]; });
   const double c = std::cos(pose.theta), s = std::sin(pose.theta);
   const Eigen::Vector2d origin(pose.x + c * scan.mount.x - s * scan.mount.y,
                                pose.y + s * scan.mount.x + c * scan.mount.y);
-  const size_t n = n0;
   std::vector<double> r(n), ang(n);
   std::vector<char> hit(n), none(n);  // a return / nothing within the sensor's range
   std::vector<Eigen::Vector2d> pt(n), dir(n);
@@ -57,16 +57,20 @@ std::vector<Doorway> findDoorways(const hw::RangeScan& scan, const hw::Pose2D& p
     none[k] = std::isfinite(r[k]) && r[k] >= scan.max_range;
     pt[k] = origin + (hit[k] ? r[k] : 0.0) * dir[k];
   }
+  // How far along the ray from the sensor in direction `d` the line through `a` along `e`
+  // is met; NaN when they are parallel.
+  auto toLine = [&](const Eigen::Vector2d& d, const Eigen::Vector2d& a, const Eigen::Vector2d& e) {
+    const double den = d.x() * e.y() - d.y() * e.x();
+    if (std::abs(den) < 1e-9) return std::numeric_limits<double>::quiet_NaN();
+    const Eigen::Vector2d q = a - origin;
+    return (q.x() * e.y() - q.y() * e.x()) / den;
+  };
   // Beam k passes the line a-b (a wall with an opening) and reads at least depth_m beyond it.
   auto beyond = [&](size_t k, const Eigen::Vector2d& a, const Eigen::Vector2d& b) {
     if (none[k]) return true;
     if (!hit[k]) return false;
-    const Eigen::Vector2d ab = b - a;
-    const double den = dir[k].x() * ab.y() - dir[k].y() * ab.x();
-    if (std::abs(den) < 1e-9) return false;
-    const Eigen::Vector2d ao = a - origin;
-    const double t = (ao.x() * ab.y() - ao.y() * ab.x()) / den;  // along the beam to the line
-    return t > 0 && r[k] >= t + p.depth_m;
+    const double t = toLine(dir[k], a, b - a);
+    return t > 0 && r[k] >= t + p.depth_m;  // false for NaN
   };
   auto farJump = [&](size_t k, size_t jamb) {
     return none[k] || (hit[k] && r[k] >= r[jamb] + p.depth_m);
@@ -144,12 +148,11 @@ std::vector<Doorway> findDoorways(const hw::RangeScan& scan, const hw::Pose2D& p
         const Eigen::Vector2d proj = c + u * (pt[on] - c).dot(u);
         if (off(pt[on]) > p.wall_tol_m) return proj;
         const double m = 0.5 * (ang[on] + ang[through]);
-        const Eigen::Vector2d dm(std::cos(m), std::sin(m)), q = c - origin;
-        const double den = dm.x() * u.y() - dm.y() * u.x();
-        if (std::abs(den) < 1e-9) return proj;
-        const double t = (q.x() * u.y() - q.y() * u.x()) / den;
+        const Eigen::Vector2d dm(std::cos(m), std::sin(m));
+        const double t = toLine(dm, c, u);
+        if (!(t > 0)) return proj;
         const Eigen::Vector2d x = origin + t * dm;
-        return t > 0 && (x - proj).norm() < 0.3 ? x : proj;
+        return (x - proj).norm() < 0.3 ? x : proj;
       };
       Doorway d;
       d.a = jamb(i, i + 1);

@@ -222,9 +222,8 @@ struct Executive::Impl {
   // along them means nothing), zero for the others.
   std::vector<Eigen::Vector2d> fixes_across;
   // Goal doorway (route goal_place): stopping points of the doorways seen near the goal
-  // (odometry frame, newest last), and whether the goal has been put on one.
+  // (odometry frame, newest last); the goal put on one is tracker.goalOdom().
   std::vector<Eigen::Vector2d> door_stops;
-  bool door_fixed = false;
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
@@ -960,7 +959,7 @@ struct Executive::Impl {
       if ((p - best_stop).norm() <= s.goal_door.agree_m) sum += p, ++n;
     if (n < s.goal_door.min_scans) return;
     const Eigen::Vector2d goal = sum / n;
-    if (!door_fixed)
+    if (!tracker.goalOdom()) {
       event({{"type", "goal_door"},
              {"centre_odom", {best->centre.x(), best->centre.y()}},
              {"width_m", best->width_m},
@@ -968,11 +967,10 @@ struct Executive::Impl {
              {"moved_m", (goal - drawn).norm()},
              {"standoff_m", place.standoff_m},
              {"sightings", n}});
-    if (!door_fixed)
       log::info("nav", "goal doorway found",
                 {{"width_m", std::to_string(best->width_m).substr(0, 4)},
                  {"moved_m", std::to_string((goal - drawn).norm()).substr(0, 4)}});
-    door_fixed = true;
+    }
     tracker.setGoalOdom(goal);
   }
 
