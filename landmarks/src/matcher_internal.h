@@ -56,6 +56,12 @@ struct Corr {
   int q, d;
   float dist;
 };
+/// RANSAC hypotheses worth drawing among n tentative correspondences: enough to find a model
+/// with min_inliers inliers, if there is one, with the given confidence — 1 − confidence ≥
+/// (1 − C(min_inliers, 4) / C(n, 4))^iterations — and never more than max_iterations. Below
+/// min_inliers correspondences nothing can verify, and the best consensus (still reported as
+/// evidence) is sought among at most C(n, 4) draws, the number of distinct 4-point samples.
+int ransacIterations(int n, int min_inliers, int max_iterations, double confidence);
 /// RANSAC homography database photo -> frame over tentative correspondences (one per
 /// database keypoint kept, the closest).
 MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,

@@ -1,7 +1,11 @@
 #include <gtest/gtest.h>
 
+#include <opencv2/calib3d.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <cmath>
+
+#include "../src/matcher_internal.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/matcher.h"
 #include "sketchnav/landmarks/model.h"
@@ -247,4 +251,54 @@ TEST(MatchParamsTest, ValidateNamesTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("min_inliers"), std::string::npos);
   }
+}
+
+TEST(RansacIterations, TheFewestThatFindAMinInliersModelWithTheConfidence) {
+  const double conf = 0.995;
+  for (int n : {12, 13, 20, 25, 40, 60}) {
+    const int it = landmarks::detail::ransacIterations(n, 12, 100000, conf);
+    // P(a 4-sample lies among the 12 inliers) = C(12,4) / C(n,4).
+    const double q = (12.0 * 11 * 10 * 9) / (double(n) * (n - 1) * (n - 2) * (n - 3));
+    EXPECT_LE(std::pow(1 - q, it), 1 - conf + 1e-12) << n;
+    if (it > 1) EXPECT_GT(std::pow(1 - q, it - 1), 1 - conf) << n;
+  }
+  EXPECT_EQ(landmarks::detail::ransacIterations(12, 12, 1000, conf),
+            1);  // every sample is an inlier one
+  EXPECT_EQ(landmarks::detail::ransacIterations(60, 12, 1000, conf), 1000);  // capped
+  // Fewer points than min_inliers: at most the number of distinct 4-point samples.
+  EXPECT_EQ(landmarks::detail::ransacIterations(8, 12, 1000, conf), 70);
+  EXPECT_EQ(landmarks::detail::ransacIterations(11, 12, 100, conf), 100);
+  EXPECT_EQ(landmarks::detail::ransacIterations(3, 12, 1000, conf), 0);
+}
+
+TEST(RansacIterations, BoundedRansacStillFindsAPlantedModelOfMinInliers) {
+  // 12 correspondences of one homography among 25 (13 random): the bound (133 hypotheses
+  // instead of 1000) must still recover all 12 in nearly every seeded trial.
+  const int n = 25, m = 12, trials = 200;
+  const int it = landmarks::detail::ransacIterations(n, m, 1000, 0.995);
+  ASSERT_LT(it, 200);
+  const cv::Matx33d H(1.1, 0.1, 30, -0.05, 0.95, 12, 1e-4, 2e-4, 1);
+  int found = 0;
+  for (int t = 0; t < trials; ++t) {
+    cv::RNG rng(100 + t);
+    std::vector<cv::Point2f> src, dst;
+    for (int i = 0; i < n; ++i) {
+      const cv::Point2f a(rng.uniform(0.f, 300.f), rng.uniform(0.f, 300.f));
+      src.push_back(a);
+      if (i < m) {
+        cv::Vec3d b = H * cv::Vec3d(a.x, a.y, 1);
+        dst.emplace_back(static_cast<float>(b[0] / b[2] + rng.gaussian(0.5)),
+                         static_cast<float>(b[1] / b[2] + rng.gaussian(0.5)));
+      } else {
+        dst.emplace_back(rng.uniform(0.f, 400.f), rng.uniform(0.f, 400.f));
+      }
+    }
+    cv::theRNG().state = 7 + t;
+    std::vector<unsigned char> mask;
+    const cv::Mat Hf = cv::findHomography(src, dst, cv::RANSAC, 6, mask, it, 0.995);
+    int planted = 0;
+    for (int i = 0; i < m && !Hf.empty(); ++i) planted += mask[i] ? 1 : 0;
+    found += planted == m ? 1 : 0;
+  }
+  EXPECT_GE(found, trials * 97 / 100);
 }
