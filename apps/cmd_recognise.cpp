@@ -12,6 +12,7 @@
 #include <map>
 
 #include "cli.h"
+#include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/landmarks/landmark_set.h"
@@ -42,6 +43,18 @@ struct Runner {
   // CPU ms per stage, summed over images: features (SIFT, RootSIFT, colours, words), objectness,
   // recognise, match.
   mutable double stage_ms[4] = {0, 0, 0, 0};
+  // CPU ms of OpenCV's SIFT alone (detect + describe, the same settings), timed in a separate
+  // pass outside run(): the floor of `features` that none of this project's code sets, and so a
+  // measure of the machine's speed beside the pipeline's figures of the same run.
+  mutable double sift_ms = 0;
+
+  void timeSiftAlone(const cv::Mat& img) const {
+    std::vector<cv::KeyPoint> kps;
+    cv::Mat u8;
+    const double c0 = threadCpuMs();
+    lm::detectSift(img, frame_features, kps, u8);
+    sift_ms += threadCpuMs() - c0;
+  }
 
   cv::Mat prepare(const cv::Mat& img) const {
     if (frame_size.area() == 0) return img;
@@ -57,8 +70,10 @@ struct Runner {
 
   // Recognition of one image, timed (features + windows + BoW + verification; not decoding):
   // wall-clock ms, and this thread's CPU ms (robust to other processes sharing the cores).
+  // match_out: the answer's match() (as the servo would get it; unmatched when rejected).
   std::vector<lm::Recognition> run(const cv::Mat& img, int top_k, double& ms,
-                                   double* cpu_ms = nullptr) const {
+                                   double* cpu_ms = nullptr,
+                                   lm::MatchResult* match_out = nullptr) const {
     const double c0 = threadCpuMs();
     const auto t0 = std::chrono::steady_clock::now();
     std::vector<cv::Rect> boxes;
@@ -69,8 +84,10 @@ struct Runner {
     const double c2 = threadCpuMs();
     auto out = lm::recognise(model, frame, boxes, top_k, params);
     const double c3 = threadCpuMs();
-    if (with_match && !out.empty() && !out.front().rejected)
-      lm::match(model, frame, out.front().window, out.front().class_name, match_params);
+    if ((with_match || match_out) && !out.empty() && !out.front().rejected) {
+      auto m = lm::match(model, frame, out.front().window, out.front().class_name, match_params);
+      if (match_out) *match_out = std::move(m);
+    }
     const double c4 = threadCpuMs();
     stage_ms[0] += c2 - c1;
     stage_ms[1] += c1 - c0;
@@ -96,7 +113,96 @@ Json modeJson(const Runner& r) {
           {"params", paramsToJson(r.params)}};
 }
 
-int evaluate(const Runner& runner, const std::string& dir, double index_ms, GlobalOptions& g) {
+// One image with what recognition made of it: the answer's database photo outlined where its
+// homography puts it, the inlier keypoints, the window searched, and the candidates listed.
+cv::Mat annotate(const cv::Mat& img, const std::vector<lm::Recognition>& res,
+                 const lm::MatchResult& m) {
+  cv::Mat vis = img.channels() == 3 ? img.clone() : cv::Mat();
+  if (vis.empty()) cv::cvtColor(img, vis, cv::COLOR_GRAY2BGR);
+  const bool rejected = res.empty() || res.front().rejected;
+  const cv::Scalar green(40, 200, 40), orange(0, 140, 255), white(255, 255, 255);
+  if (!res.empty() && res.front().window.area() > 0)
+    cv::rectangle(vis, res.front().window, cv::Scalar(200, 200, 0), 1);
+  if (m.matched && !m.H.empty()) {
+    const float w = static_cast<float>(m.database_size.width),
+                h = static_cast<float>(m.database_size.height);
+    std::vector<cv::Point2f> corners{{0, 0}, {w, 0}, {w, h}, {0, h}}, out;
+    cv::perspectiveTransform(corners, out, m.H);
+    std::vector<cv::Point> poly(out.begin(), out.end());
+    cv::polylines(vis, poly, true, green, 2, cv::LINE_AA);
+    for (const auto& p : m.x_t) cv::circle(vis, p, 3, orange, 1, cv::LINE_AA);
+  }
+  // Candidates, best first, on a dark band so they read on any image.
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  const double fs = 0.45;
+  std::vector<std::string> lines;
+  lines.push_back(rejected ? "none of these" : res.front().class_name);
+  char b[160];
+  for (size_t i = 0; i < res.size() && i < 3; ++i) {
+    const auto& r = res[i];
+    std::snprintf(b, sizeof b, "%zu. %s  inliers %d  votes %d  colour p %.2f%s", i + 1,
+                  r.class_name.c_str(), r.inliers, r.votes, r.colour_probability,
+                  r.rejected ? "" : (r.colour_rescued ? "  (colour rescued)" : "  (verified)"));
+    lines.push_back(b);
+  }
+  const int line_h = 18;
+  const cv::Rect band(0, 0, vis.cols,
+                      std::min(vis.rows, 8 + line_h * static_cast<int>(lines.size())));
+  cv::Mat roi = vis(band);
+  cv::addWeighted(roi, 0.35, cv::Mat(roi.size(), roi.type(), cv::Scalar(0, 0, 0)), 0.65, 0, roi);
+  for (size_t i = 0; i < lines.size(); ++i)
+    cv::putText(vis, lines[i], {6, 16 + line_h * static_cast<int>(i)}, font, i == 0 ? 0.55 : fs,
+                i == 0 ? (rejected ? orange : green) : white, 1, cv::LINE_AA);
+  return vis;
+}
+
+// The evaluation's confusion matrix as a picture: the eval folder's classes as rows (those the
+// model does not know last), the answers as columns in the same order, then any other class
+// answered, then "(none)".
+void writeConfusionPlot(const std::string& path, const std::string& dir, const Json& per_class,
+                        const lm::LandmarkModel& model) {
+  ConfusionSpec spec;
+  std::vector<std::string> names;
+  for (bool known : {true, false})
+    for (const auto& [name, pc] : per_class.items())
+      if (pc["known"].get<bool>() == known) names.push_back(name);
+  for (const auto& n : names)
+    if (model.classId(n) >= 0) spec.cols.push_back(n);
+  std::vector<std::string> others;
+  for (const auto& [name, pc] : per_class.items())
+    for (const auto& [pred, k] : pc["predicted"].items())
+      if (pred != "(none)" &&
+          std::find(spec.cols.begin(), spec.cols.end(), pred) == spec.cols.end() &&
+          std::find(others.begin(), others.end(), pred) == others.end())
+        others.push_back(pred);
+  std::sort(others.begin(), others.end());
+  spec.cols.insert(spec.cols.end(), others.begin(), others.end());
+  spec.cols.push_back("(none)");
+  char note[64];
+  for (const auto& n : names) {
+    const Json& pc = per_class[n];
+    const bool known = pc["known"].get<bool>();
+    spec.rows.push_back(known ? n : n + " (not in model)");
+    std::vector<int> row(spec.cols.size(), 0);
+    for (const auto& [pred, k] : pc["predicted"].items()) {
+      const auto it = std::find(spec.cols.begin(), spec.cols.end(), pred);
+      if (it != spec.cols.end()) row[it - spec.cols.begin()] += k.get<int>();
+    }
+    spec.counts.push_back(row);
+    const int images = pc["images"].get<int>();
+    if (known)
+      std::snprintf(note, sizeof note, "top-1 %.2f of %d", pc["top1"].get<double>(), images);
+    else
+      std::snprintf(note, sizeof note, "rejected %d of %d", pc["rejected"].get<int>(), images);
+    spec.row_notes.push_back(note);
+  }
+  spec.title = "sketchnav recognise --eval " + dir;
+  if (!cv::imwrite(path, drawConfusionMatrix(spec)))
+    throw RuntimeError("sketchnav recognise: cannot write --plot file '" + path + "'");
+}
+
+int evaluate(const Runner& runner, const std::string& dir, double index_ms, GlobalOptions& g,
+             const std::string& plot_path) {
   const lm::LandmarkSet set = lm::scanLandmarkSet(dir);
   int n_known = 0, n_unknown = 0, top1 = 0, top1_any = 0, top3 = 0, false_rej = 0, unknown_rej = 0,
       failed = 0;
@@ -122,6 +228,7 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
       img = runner.prepare(img);
       double ms = 0, cpu = 0;
       const auto res = runner.run(img, runner.details ? 8 : 3, ms, &cpu);
+      runner.timeSiftAlone(img);
       if (runner.details) {
         Json cands = Json::array();
         for (const auto& r : res)
@@ -196,9 +303,11 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
               {"objectness", runner.stage_ms[1] / n},
               {"recognise", runner.stage_ms[2] / n},
               {"match", runner.stage_ms[3] / n}}},
+            {"sift_alone_cpu_ms_mean", runner.sift_ms / n},
             {"ms_p95", times[std::min(times.size() - 1, times.size() * 95 / 100)]},
             {"mode", modeJson(runner)},
             {"per_class", per_class}};
+  if (!plot_path.empty()) writeConfusionPlot(plot_path, dir, per_class, runner.model);
   if (g.json) {
     printJson(j);
     return 0;
@@ -217,8 +326,10 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
   std::printf("top-1 %.3f   top-3 %.3f   false rejections %.3f\n", frac(top1, n_known),
               frac(top3, n_known), frac(false_rej, n_known));
   if (n_unknown) std::printf("rejected unknown-class images %.3f\n", frac(unknown_rej, n_unknown));
-  std::printf("ms per image: mean %.1f, p95 %.1f (CPU of this thread: mean %.1f)\n", ms_sum / n,
-              j["ms_p95"].get<double>(), cpu_sum / n);
+  std::printf(
+      "ms per image: mean %.1f, p95 %.1f (CPU of this thread: mean %.1f; OpenCV's SIFT "
+      "alone on the same images: %.1f)\n",
+      ms_sum / n, j["ms_p95"].get<double>(), cpu_sum / n, runner.sift_ms / n);
   return 0;
 }
 
@@ -231,6 +342,8 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("top-k", "candidates printed per image", "3")
       .option("windows", "objectness windows per image (0 = the whole image)", "0")
       .option("details", "with --eval: write one JSON line per image (candidates and evidence)")
+      .option("plot", "with --eval: write the confusion matrix as a PNG (rows: true class)")
+      .option("annotate", "with IMAGE...: write each image with its answer drawn into this folder")
       .option("frame", "letterbox each image into a WxH camera frame first, e.g. 640x480")
       .flag("match", "also match the recognised class (the servo's per-frame cost) in the timing")
       .flag("no-verify", "BoW + SVM only, no geometric verification (for comparisons)");
@@ -273,8 +386,33 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (!details) throw InputError(args.get("details") + ": cannot write --details file");
     runner.details = &details;
   }
-  if (!args.get("eval").empty()) return evaluate(runner, args.get("eval"), index_ms, g);
+  if (!args.get("plot").empty()) {
+    // Checked before the evaluation, so a mistyped path does not cost the figures of a long run.
+    const std::filesystem::path plot(args.get("plot"));
+    const auto parent = plot.has_parent_path() ? plot.parent_path() : std::filesystem::path(".");
+    if (plot.extension() != ".png")
+      throw InputError("sketchnav recognise: --plot '" + plot.string() + "' must end in .png");
+    if (!std::filesystem::is_directory(parent))
+      throw InputError("sketchnav recognise: --plot folder '" + parent.string() +
+                       "' does not exist");
+  }
+  if (!args.get("eval").empty()) {
+    if (!args.get("annotate").empty())
+      throw InputError("sketchnav recognise: --annotate is for IMAGE..., not --eval");
+    return evaluate(runner, args.get("eval"), index_ms, g, args.get("plot"));
+  }
+  if (!args.get("plot").empty())
+    throw InputError("sketchnav recognise: --plot needs --eval DIR (it draws the evaluation)");
 
+  const std::string annotate_dir = args.get("annotate");
+  int annotated = 0;
+  if (!annotate_dir.empty()) {
+    std::error_code ec;
+    std::filesystem::create_directories(annotate_dir, ec);
+    if (ec)
+      throw InputError("sketchnav recognise: cannot create --annotate folder '" + annotate_dir +
+                       "': " + ec.message());
+  }
   Json out = Json::array();
   int unreadable = 0;
   for (const auto& path : args.positional()) {
@@ -287,7 +425,17 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
       continue;
     }
     double ms = 0;
-    const auto res = runner.run(img, top_k, ms);
+    lm::MatchResult m;
+    const auto res = runner.run(img, top_k, ms, nullptr, annotate_dir.empty() ? nullptr : &m);
+    if (!annotate_dir.empty()) {
+      char name[32];
+      std::snprintf(name, sizeof name, "%03d_", ++annotated);
+      const std::string file = (std::filesystem::path(annotate_dir) /
+                                (name + std::filesystem::path(path).stem().string() + ".png"))
+                                   .string();
+      if (!cv::imwrite(file, annotate(img, res, m)))
+        throw RuntimeError("sketchnav recognise: cannot write '" + file + "'");
+    }
     Json cands = Json::array();
     for (const auto& r : res)
       cands.push_back({{"class", r.class_name},

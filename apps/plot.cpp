@@ -140,4 +140,66 @@ cv::Mat drawLinePlot(const PlotSpec& spec, const std::vector<PlotSeries>& series
   return img;
 }
 
+cv::Mat drawConfusionMatrix(const ConfusionSpec& spec) {
+  const int font = cv::FONT_HERSHEY_SIMPLEX;
+  const double fs = 0.4;
+  const int cell = 18;
+  auto textWidth = [&](const std::string& t) {
+    int base = 0;
+    return cv::getTextSize(t, font, fs, 1, &base).width;
+  };
+  int row_w = 0, col_h = 0, note_w = 0;
+  for (const auto& r : spec.rows) row_w = std::max(row_w, textWidth(r));
+  for (const auto& c : spec.cols) col_h = std::max(col_h, textWidth(c));
+  for (const auto& n : spec.row_notes) note_w = std::max(note_w, textWidth(n));
+  const int nr = static_cast<int>(spec.rows.size()), nc = static_cast<int>(spec.cols.size());
+  const int left = row_w + 12, top = col_h + 40, right = note_w + 16, bottom = 30;
+  int base = 0;
+  const int title_w = cv::getTextSize(spec.title, font, 0.5, 1, &base).width;
+  const int width = std::max(left + nc * cell + right, title_w + 20);
+  cv::Mat img(top + nr * cell + bottom, width, CV_8UC3, cv::Scalar(255, 255, 255));
+  cv::putText(img, spec.title, {10, 20}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+  // Column labels: drawn horizontally on a strip, then turned to read bottom-up.
+  for (int c = 0; c < nc; ++c) {
+    cv::Mat strip(cell, col_h + 4, CV_8UC3, cv::Scalar(255, 255, 255));
+    cv::putText(strip, spec.cols[c], {2, cell - 5}, font, fs, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    cv::Mat up;
+    cv::rotate(strip, up, cv::ROTATE_90_COUNTERCLOCKWISE);
+    up.copyTo(img(cv::Rect(left + c * cell, top - up.rows - 2, up.cols, up.rows)));
+  }
+  for (int r = 0; r < nr; ++r) {
+    const int y = top + r * cell;
+    cv::putText(img, spec.rows[r], {left - 6 - textWidth(spec.rows[r]), y + cell - 5}, font, fs,
+                cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+    int total = 0;
+    for (int c = 0; c < nc; ++c) total += spec.counts[r][c];
+    for (int c = 0; c < nc; ++c) {
+      const cv::Rect box(left + c * cell, y, cell, cell);
+      const int n = spec.counts[r][c];
+      // White (none) to dark blue (the whole row).
+      const double f = total > 0 ? static_cast<double>(n) / total : 0.0;
+      const cv::Scalar shade(255 - 75 * f, 255 - 200 * f, 255 - 225 * f);
+      cv::rectangle(img, box, shade, cv::FILLED);
+      cv::rectangle(img, box, cv::Scalar(225, 225, 225), 1);
+      if (n > 0) {
+        const std::string t = std::to_string(n);
+        cv::putText(img, t, {box.x + (cell - textWidth(t)) / 2, box.y + cell - 5}, font, fs,
+                    f > 0.5 ? cv::Scalar(255, 255, 255) : cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
+      }
+    }
+    if (r < static_cast<int>(spec.row_notes.size()))
+      cv::putText(img, spec.row_notes[r], {left + nc * cell + 8, y + cell - 5}, font, fs,
+                  cv::Scalar(60, 60, 60), 1, cv::LINE_AA);
+  }
+  // The right answers' outlines last, so no neighbouring cell's border covers them.
+  for (int r = 0; r < nr; ++r)
+    for (int c = 0; c < nc; ++c)
+      if (spec.cols[c] == spec.rows[r])
+        cv::rectangle(img, cv::Rect(left + c * cell, top + r * cell, cell, cell),
+                      cv::Scalar(40, 160, 40), 2);
+  cv::putText(img, "rows: true class; columns: answer (shaded by share of the row)",
+              {10, img.rows - 10}, font, fs, cv::Scalar(90, 90, 90), 1, cv::LINE_AA);
+  return img;
+}
+
 }  // namespace sketchnav::app

@@ -24,6 +24,19 @@ struct PlotSpec {
 /// Draws the series as lines with dots; returns the image.
 cv::Mat drawLinePlot(const PlotSpec& spec, const std::vector<PlotSeries>& series);
 
+/// A confusion matrix: rows are the true classes, columns the answers; counts[r][c].
+struct ConfusionSpec {
+  std::string title;
+  std::vector<std::string> rows, cols;
+  std::vector<std::vector<int>> counts;  // rows.size() x cols.size()
+  std::vector<std::string> row_notes;    // printed right of each row (e.g. its top-1); optional
+};
+
+/// Draws the matrix as a heat map: each cell shaded by its share of the row (so classes with
+/// few images read the same as classes with many), its count printed, the cells whose column
+/// names the row's class outlined (the right answers), column labels written vertically.
+cv::Mat drawConfusionMatrix(const ConfusionSpec& spec);
+
 /// A distinct colour for series i.
 cv::Scalar plotColor(int i);
 

@@ -19,3 +19,10 @@ add_test(NAME cli_run_reports_ground_truth
 set_tests_properties(cli_run_reports_ground_truth PROPERTIES
   PASS_REGULAR_EXPRESSION "ground truth: odometry off [0-9.]+ m.*the sketch alone puts the goal [0-9.]+ m off"
   TIMEOUT 300)
+# recognise --eval --plot and --annotate write their pictures (a demo-set model, 4 images).
+# Its own folder: cli_exit_codes empties cli-work when it starts.
+add_test(NAME cli_recognise_pictures
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DSRC=${PROJECT_SOURCE_DIR}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-recognise-pictures
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/recognise_outputs.cmake)
+set_tests_properties(cli_recognise_pictures PROPERTIES TIMEOUT 600)

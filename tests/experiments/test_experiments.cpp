@@ -145,6 +145,32 @@ TEST(Plot, DrawsAxesAndSeries) {
   EXPECT_GT(coloured, 50);
 }
 
+TEST(Plot, ConfusionMatrixShadesByRowShareAndOutlinesTheRightAnswers) {
+  auto count = [](const cv::Mat& img, const cv::Vec3b& c) {
+    int n = 0;
+    for (int y = 0; y < img.rows; ++y)
+      for (int x = 0; x < img.cols; ++x) n += img.at<cv::Vec3b>(y, x) == c;
+    return n;
+  };
+  ConfusionSpec spec;
+  spec.title = "t";
+  spec.rows = {"a", "b"};
+  spec.cols = {"a", "b", "(none)"};
+  spec.counts = {{3, 1, 0}, {0, 0, 2}};
+  spec.row_notes = {"top-1 0.75", "top-1 0.00"};
+  const cv::Mat two = drawConfusionMatrix(spec);
+  const cv::Vec3b full_row(180, 55, 30);  // b -> (none): the whole row
+  const cv::Vec3b outline(40, 160, 40);   // a -> a and b -> b
+  EXPECT_GT(count(two, full_row), 100);
+  EXPECT_GT(count(two, outline), 2 * 4 * 14);
+  // Without a right answer in a row, no outline; with a third row, one cell taller.
+  spec.rows.push_back("c");
+  spec.counts.push_back({0, 0, 1});
+  const cv::Mat three = drawConfusionMatrix(spec);
+  EXPECT_EQ(three.rows, two.rows + 18);
+  EXPECT_EQ(count(three, outline), count(two, outline));
+}
+
 }  // namespace
 }  // namespace sketchnav::app
 

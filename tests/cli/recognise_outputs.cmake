@@ -1,0 +1,80 @@
+# sketchnav recognise's pictures, driven as a user would: --eval DIR --plot (the confusion
+# matrix) and IMAGE... --annotate DIR (each image with its answer drawn), on a model of the
+# shipped demo set; and the one-line errors for the options used the wrong way.
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK}/eval/Tropicana-Apple-Juice ${WORK}/eval/Oatly-Oat-Milk
+     ${WORK}/eval/Not-In-The-Model)
+include(${CMAKE_CURRENT_LIST_DIR}/../support/expect_exit.cmake)
+set(L ${SRC}/share/landmarks)
+file(COPY ${L}/Tropicana-Apple-Juice/Tropicana-Apple-Juice_001.jpg
+          ${L}/Tropicana-Apple-Juice/Tropicana-Apple-Juice_004.jpg
+     DESTINATION ${WORK}/eval/Tropicana-Apple-Juice)
+file(COPY ${L}/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg DESTINATION ${WORK}/eval/Oatly-Oat-Milk)
+file(COPY ${CMAKE_CURRENT_LIST_DIR}/fixtures/tiny.png DESTINATION ${WORK}/eval/Not-In-The-Model)
+
+execute_process(COMMAND ${SN} --json train --landmarks ${L} -o ${WORK}/demo.slm
+                RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "train failed (${rc}):\n${err}")
+endif()
+
+# PNG signature and the IHDR chunk's width and height.
+function(png_size file out_w out_h)
+  if(NOT EXISTS ${file})
+    message(FATAL_ERROR "${file} was not written")
+  endif()
+  file(READ ${file} head LIMIT 24 HEX)
+  string(SUBSTRING "${head}" 0 16 sig)
+  if(NOT sig STREQUAL "89504e470d0a1a0a")
+    message(FATAL_ERROR "${file} is not a PNG (${head})")
+  endif()
+  string(SUBSTRING "${head}" 32 8 w)
+  string(SUBSTRING "${head}" 40 8 h)
+  math(EXPR w "0x${w}")
+  math(EXPR h "0x${h}")
+  set(${out_w} ${w} PARENT_SCOPE)
+  set(${out_h} ${h} PARENT_SCOPE)
+endfunction()
+
+execute_process(COMMAND ${SN} --json recognise --model ${WORK}/demo.slm --eval ${WORK}/eval
+                        --plot ${WORK}/confusion.png
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "recognise --eval --plot failed (${rc}):\n${out}\n${err}")
+endif()
+string(JSON images GET "${out}" images)
+string(JSON top1 GET "${out}" top1)
+string(JSON sift GET "${out}" sift_alone_cpu_ms_mean)
+if(NOT images EQUAL 4 OR top1 LESS 0.99 OR NOT sift GREATER 0)
+  message(FATAL_ERROR "recognise --eval: images ${images} (4), top-1 ${top1} (1 on photos it "
+                      "was trained on), SIFT alone ${sift} ms (> 0):\n${out}")
+endif()
+# Three rows (two known classes, one not in the model): at least three 18 px cells tall below
+# the column labels, and wide enough for the columns and the row labels.
+png_size(${WORK}/confusion.png w h)
+if(w LESS 300 OR h LESS 150)
+  message(FATAL_ERROR "confusion.png is ${w} x ${h}: too small for 3 rows and their labels")
+endif()
+
+execute_process(COMMAND ${SN} recognise --model ${WORK}/demo.slm --frame 640x480
+                        --annotate ${WORK}/annotated
+                        ${WORK}/eval/Tropicana-Apple-Juice/Tropicana-Apple-Juice_001.jpg
+                        ${WORK}/eval/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "recognise --annotate failed (${rc}):\n${out}\n${err}")
+endif()
+png_size(${WORK}/annotated/001_Tropicana-Apple-Juice_001.png w h)
+if(NOT w EQUAL 640 OR NOT h EQUAL 480)
+  message(FATAL_ERROR "annotated frame is ${w} x ${h}, expected the 640 x 480 frame")
+endif()
+png_size(${WORK}/annotated/002_Oatly-Oat-Milk_001.png w h)
+
+expect(2 "--plot needs --eval" recognise --model ${WORK}/demo.slm --plot ${WORK}/x.png
+       ${WORK}/eval/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg)
+expect(2 "--plot '${WORK}/x.jpg' must end in .png" recognise --model ${WORK}/demo.slm
+       --eval ${WORK}/eval --plot ${WORK}/x.jpg)
+expect(2 "--plot folder '${WORK}/missing' does not exist" recognise --model ${WORK}/demo.slm
+       --eval ${WORK}/eval --plot ${WORK}/missing/x.png)
+expect(2 "--annotate is for IMAGE" recognise --model ${WORK}/demo.slm --eval ${WORK}/eval
+       --annotate ${WORK}/x)
