@@ -197,7 +197,7 @@ void writeConfusionPlot(const std::string& path, const std::string& dir, const J
     spec.row_notes.push_back(note);
   }
   spec.title = "sketchnav recognise --eval " + dir;
-  if (!cv::imwrite(path, drawConfusionMatrix(spec)))
+  if (!cv::imwrite(path, drawConfusionMatrix(spec), {cv::IMWRITE_PNG_COMPRESSION, 9}))
     throw RuntimeError("sketchnav recognise: cannot write --plot file '" + path + "'");
 }
 

@@ -30,6 +30,8 @@
 #                    640x480 frames with match: 6 classes known, 14 unknown (to be rejected);
 #                    demo_no_colour_rescue the same without the colour rescue
 #
+# confusion_rootsift.png and confusion_frame_fast.png: those rows' confusion matrices.
+#
 # Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
 # Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean, and per
 # stage: features = SIFT + RootSIFT + colours + words, recognise, match) with OpenCV on one
@@ -78,7 +80,7 @@ train synth --set landmarks.train.synth_views=2
 usable "$OUT/demo.slm" || "$BIN" --json train --landmarks "$root/share/landmarks" -o "$OUT/demo.slm" \
   > "$OUT/train_demo.json"
 
-evaluate rootsift rootsift
+evaluate rootsift rootsift --plot "$OUT/confusion_rootsift.png"
 evaluate no_sibling_check rootsift $NO_SIBLING
 evaluate no_colour_rescue rootsift $NO_RESCUE
 evaluate min16 rootsift $MIN16
@@ -92,7 +94,8 @@ evaluate windows_no_colour_rescue rootsift --windows 10 $NO_RESCUE
 evaluate frame rootsift --frame 640x480 --match
 evaluate frame_no_sibling_check rootsift --frame 640x480 --match $NO_SIBLING
 evaluate frame_no_colour_rescue rootsift --frame 640x480 --match $NO_RESCUE
-evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST"
+evaluate frame_fast rootsift --frame 640x480 --match --config "$FAST" \
+  --plot "$OUT/confusion_frame_fast.png"
 evaluate combined rootsift $COMBINED
 evaluate synth synth
 evaluate synth_frame synth --frame 640x480 --match
