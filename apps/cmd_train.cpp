@@ -1,5 +1,7 @@
 // sketchnav train: build a landmark model (.slm) from a folder of class folders.
+#include <algorithm>
 #include <chrono>
+#include <cstdio>
 #include <iostream>
 
 #include "cli.h"
@@ -48,6 +50,31 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   if (!last_stage.empty() && !(g.json && !g.verbose)) std::cerr << "\n";
   m.save(args.get("output"));
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // Per class: its photos and keypoints, and what would make it weak (the photos a user has to
+  // retake are easier to find here than in recognition figures later).
+  constexpr int kFewPhotos = 3;
+  const int few_keypoints = std::max(20, p.features.max_features / 4);
+  Json per_class = Json::object();
+  int weak = 0;
+  for (size_t c = 0; c < m.classes().size(); ++c) {
+    const auto& ids = m.photosOfClass(static_cast<int>(c));
+    int kmin = 1 << 30, ksum = 0;
+    for (int id : ids) {
+      const int k = static_cast<int>(m.photos()[id].keypoints.size());
+      kmin = std::min(kmin, k), ksum += k;
+    }
+    const int n = static_cast<int>(ids.size());
+    const double kmean = n ? static_cast<double>(ksum) / n : 0.0;
+    Json warn = Json::array();
+    if (n < kFewPhotos) warn.push_back("few photos: add views from other angles and distances");
+    if (kmean < few_keypoints)
+      warn.push_back("few keypoints: little texture in view; photograph it closer or fuller");
+    weak += warn.empty() ? 0 : 1;
+    per_class[m.classes()[c]] = {{"photos", n},
+                                 {"keypoints_mean", kmean},
+                                 {"keypoints_min", n ? kmin : 0},
+                                 {"warnings", warn}};
+  }
   Json j = {{"model", args.get("output")},
             {"classes", m.classes().size()},
             {"photos", m.photos().size()},
@@ -55,14 +82,26 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
             {"descriptor", p.features.root_sift ? "RootSIFT" : "SIFT"},
             {"seconds", secs},
             {"excluded", args.getList("exclude")},
-            {"params", paramsToJson(p)}};
+            {"params", paramsToJson(p)},
+            {"weak_classes", weak},
+            {"per_class", per_class}};
   if (g.json) {
     printJson(j);
   } else {
     std::cout << "model      " << args.get("output") << "\nclasses    " << m.classes().size()
               << "\nphotos     " << m.photos().size() << "\nwords      " << m.vocabulary().size()
               << "\ndescriptor " << j["descriptor"].get<std::string>() << "\nseconds    " << secs
-              << "\n";
+              << "\n\n";
+    std::printf("%-40s %6s %15s  %s\n", "class", "photos", "keypoints mean", "(min)");
+    for (const auto& [name, pc] : per_class.items()) {
+      std::string w;
+      for (const auto& x : pc["warnings"]) w += "  " + x.get<std::string>();
+      std::printf("%-40s %6d %15.0f  (%d)%s\n", name.c_str(), pc["photos"].get<int>(),
+                  pc["keypoints_mean"].get<double>(), pc["keypoints_min"].get<int>(), w.c_str());
+    }
+    if (weak > 0)
+      std::printf("\n%d class%s may be recognised poorly (see the notes above)\n", weak,
+                  weak == 1 ? "" : "es");
   }
   return 0;
 }

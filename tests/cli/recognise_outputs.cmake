@@ -18,6 +18,21 @@ if(NOT rc EQUAL 0)
   message(FATAL_ERROR "train failed (${rc}):\n${err}")
 endif()
 
+# train's per-class report: classes of fewer than 3 photos are flagged (the eval folder as a set:
+# 2 + 1 photos; the tiny fixture has too few keypoints and its class is dropped).
+execute_process(COMMAND ${SN} --json train --landmarks ${WORK}/eval -o ${WORK}/small.slm
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "train of the small set failed (${rc}):\n${out}\n${err}")
+endif()
+string(JSON weak GET "${out}" weak_classes)
+string(JSON oatly_photos GET "${out}" per_class Oatly-Oat-Milk photos)
+string(JSON oatly_warning GET "${out}" per_class Oatly-Oat-Milk warnings 0)
+if(NOT weak EQUAL 2 OR NOT oatly_photos EQUAL 1 OR NOT oatly_warning MATCHES "few photos")
+  message(FATAL_ERROR "train per-class report: weak ${weak} (2), Oatly photos ${oatly_photos} "
+                      "(1), warning '${oatly_warning}':\n${out}")
+endif()
+
 # PNG signature and the IHDR chunk's width and height.
 function(png_size file out_w out_h)
   if(NOT EXISTS ${file})
