@@ -117,20 +117,33 @@ Json modeJson(const Runner& r) {
 // homography puts it, the inlier keypoints, the window searched, and the candidates listed.
 cv::Mat annotate(const cv::Mat& img, const std::vector<lm::Recognition>& res,
                  const lm::MatchResult& m) {
-  cv::Mat vis = img.channels() == 3 ? img.clone() : cv::Mat();
-  if (vis.empty()) cv::cvtColor(img, vis, cv::COLOR_GRAY2BGR);
+  cv::Mat bgr = img;
+  if (img.channels() == 1) cv::cvtColor(img, bgr, cv::COLOR_GRAY2BGR);
+  // Small images are enlarged to 640 px wide so the candidate lines fit on them; never drawn
+  // on in place (the caller's image).
+  const double s = std::max(1.0, 640.0 / std::max(1, bgr.cols));
+  cv::Mat vis;
+  if (s > 1)
+    cv::resize(bgr, vis, cv::Size(), s, s, cv::INTER_LINEAR);
+  else
+    vis = bgr.clone();
+  const float sf = static_cast<float>(s);
   const bool rejected = res.empty() || res.front().rejected;
   const cv::Scalar green(40, 200, 40), orange(0, 140, 255), white(255, 255, 255);
-  if (!res.empty() && res.front().window.area() > 0)
-    cv::rectangle(vis, res.front().window, cv::Scalar(200, 200, 0), 1);
+  if (!res.empty() && res.front().window.area() > 0) {
+    const cv::Rect2f w(res.front().window);
+    cv::rectangle(vis, cv::Rect2f(w.x * sf, w.y * sf, w.width * sf, w.height * sf),
+                  cv::Scalar(200, 200, 0), 1);
+  }
   if (m.matched && !m.H.empty()) {
     const float w = static_cast<float>(m.database_size.width),
                 h = static_cast<float>(m.database_size.height);
     std::vector<cv::Point2f> corners{{0, 0}, {w, 0}, {w, h}, {0, h}}, out;
     cv::perspectiveTransform(corners, out, m.H);
-    std::vector<cv::Point> poly(out.begin(), out.end());
+    std::vector<cv::Point> poly;
+    for (const auto& p : out) poly.emplace_back(p * sf);
     cv::polylines(vis, poly, true, green, 2, cv::LINE_AA);
-    for (const auto& p : m.x_t) cv::circle(vis, p, 3, orange, 1, cv::LINE_AA);
+    for (const auto& p : m.x_t) cv::circle(vis, p * sf, 3, orange, 1, cv::LINE_AA);
   }
   // Candidates, best first, on a dark band so they read on any image.
   const int font = cv::FONT_HERSHEY_SIMPLEX;
