@@ -32,7 +32,7 @@
 #
 # confusion_rootsift.png and confusion_frame_fast.png: those rows' confusion matrices.
 #
-# Usage: bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
+# Usage: [SEEDS=2,3] bench/recognition/run.sh [SKETCHNAV_BINARY] [GROCERY_DIR] [OUT_DIR]
 # Times are wall-clock ms (ms_mean) and the recognising thread's CPU ms (cpu_ms_mean, and per
 # stage: features = SIFT + RootSIFT + colours + words, recognise, match) with OpenCV on one
 # thread; the machine's load shows in the difference. match() reuses recognise()'s verification
@@ -50,6 +50,7 @@ BIN=${1:-$root/build/release/apps/sketchnav}
 DATA=${2:-${SKETCHNAV_DATA:-$root/../shared/data}/grocery-packages}
 OUT=${3:-$root/runs/bench-recognition}
 EXCLUDED=Oatly-Oat-Milk,Yoggi-Vanilla-Yoghurt,Bravo-Orange-Juice
+SEEDS=${SEEDS:-}
 FAST=$here/fast.json
 NO_COLOUR="--set landmarks.recognition.colour_tolerance=0"
 COMBINED="--set landmarks.recognition.combined_score=true"
@@ -109,6 +110,15 @@ evaluate rejection_combined rootsift_excluded $COMBINED
 evaluate demo demo --frame 640x480 --match
 evaluate demo_no_colour_rescue demo --frame 640x480 --match $NO_RESCUE
 
+# SEEDS=2,3 (optional): the product retrained with other vocabulary / calibration seeds and
+# evaluated on photos and fast frames, so the summary shows how far a val figure moves with the
+# seed alone (one val photo is one point).
+for seed in ${SEEDS//,/ }; do
+  train "rootsift_seed$seed" --seed "$seed"
+  evaluate "rootsift_seed$seed" "rootsift_seed$seed"
+  evaluate "frame_fast_seed$seed" "rootsift_seed$seed" --frame 640x480 --match --config "$FAST"
+done
+
 python3 - "$OUT" <<'PY'
 import json, os, sys
 out = sys.argv[1]
@@ -135,6 +145,15 @@ for name, s in summary.items():
     rows.append("| %s | %s | %s | %s | %s | %s | %s | %s | %s | %s |" % (name, fmt(s["top1"]), fmt(s["top1_ignoring_rejection"]), fmt(s["top3"]),
                 fmt(s["rejected"]), fmt(s["false_rejected"]), fmt(s["cpu_ms_mean"]), stages,
                 fmt(s.get("sift_alone_cpu_ms_mean")), fmt(s["ms_mean"])))
+# With SEEDS: the spread of top-1 over the seeds (seed 1 = the rows without a suffix).
+for base in ("rootsift", "frame_fast"):
+    seeded = [k for k in summary if k.startswith(base + "_seed")]
+    if seeded and base in summary:
+        t = [summary[base]["top1"]] + [summary[k]["top1"] for k in sorted(seeded)]
+        rows.append("")
+        seeds = ["1"] + [k.split("_seed")[1] for k in sorted(seeded)]
+        rows.append("%s top-1 over seeds %s: %s (min %.2f, mean %.3f, max %.2f)" % (
+            base, ", ".join(seeds), ", ".join("%.2f" % v for v in t), min(t), sum(t) / len(t), max(t)))
 open(os.path.join(out, "summary.md"), "w").write("\n".join(rows) + "\n")
 print("\n".join(rows))
 PY
