@@ -24,6 +24,9 @@ namespace {
 
 namespace lm = landmarks;
 
+// The answer "none of these" in the evaluation's per-class counts (and its plot's last column).
+constexpr const char* kNoAnswer = "(none)";
+
 double threadCpuMs() {
   timespec ts{};
   clock_gettime(CLOCK_THREAD_CPUTIME_ID, &ts);
@@ -184,13 +187,13 @@ void writeConfusionPlot(const std::string& path, const std::string& dir, const J
   std::vector<std::string> others;
   for (const auto& [name, pc] : per_class.items())
     for (const auto& [pred, k] : pc["predicted"].items())
-      if (pred != "(none)" &&
+      if (pred != kNoAnswer &&
           std::find(spec.cols.begin(), spec.cols.end(), pred) == spec.cols.end() &&
           std::find(others.begin(), others.end(), pred) == others.end())
         others.push_back(pred);
   std::sort(others.begin(), others.end());
   spec.cols.insert(spec.cols.end(), others.begin(), others.end());
-  spec.cols.push_back("(none)");
+  spec.cols.push_back(kNoAnswer);
   char note[64];
   for (const auto& n : names) {
     const Json& pc = per_class[n];
@@ -269,7 +272,7 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
       cpu_sum += cpu;
       times.push_back(ms);
       const bool rejected = res.empty() || res.front().rejected;
-      const std::string pred = rejected ? "(none)" : res.front().class_name;
+      const std::string pred = rejected ? kNoAnswer : res.front().class_name;
       ++pc_n;
       pc["predicted"][pred] = pc["predicted"].value(pred, 0) + 1;
       if (rejected) pc["rejected"] = pc["rejected"].get<int>() + 1;

@@ -144,19 +144,17 @@ cv::Mat drawConfusionMatrix(const ConfusionSpec& spec) {
   const int font = cv::FONT_HERSHEY_SIMPLEX;
   const double fs = 0.4;
   const int cell = 18;
-  auto textWidth = [&](const std::string& t) {
+  auto textWidth = [&](const std::string& t, double scale) {
     int base = 0;
-    return cv::getTextSize(t, font, fs, 1, &base).width;
+    return cv::getTextSize(t, font, scale, 1, &base).width;
   };
   int row_w = 0, col_h = 0, note_w = 0;
-  for (const auto& r : spec.rows) row_w = std::max(row_w, textWidth(r));
-  for (const auto& c : spec.cols) col_h = std::max(col_h, textWidth(c));
-  for (const auto& n : spec.row_notes) note_w = std::max(note_w, textWidth(n));
+  for (const auto& r : spec.rows) row_w = std::max(row_w, textWidth(r, fs));
+  for (const auto& c : spec.cols) col_h = std::max(col_h, textWidth(c, fs));
+  for (const auto& n : spec.row_notes) note_w = std::max(note_w, textWidth(n, fs));
   const int nr = static_cast<int>(spec.rows.size()), nc = static_cast<int>(spec.cols.size());
   const int left = row_w + 12, top = col_h + 40, right = note_w + 16, bottom = 30;
-  int base = 0;
-  const int title_w = cv::getTextSize(spec.title, font, 0.5, 1, &base).width;
-  const int width = std::max(left + nc * cell + right, title_w + 20);
+  const int width = std::max(left + nc * cell + right, textWidth(spec.title, 0.5) + 20);
   cv::Mat img(top + nr * cell + bottom, width, CV_8UC3, cv::Scalar(255, 255, 255));
   cv::putText(img, spec.title, {10, 20}, font, 0.5, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
   // Column labels: drawn horizontally on a strip, then turned to read bottom-up.
@@ -169,7 +167,7 @@ cv::Mat drawConfusionMatrix(const ConfusionSpec& spec) {
   }
   for (int r = 0; r < nr; ++r) {
     const int y = top + r * cell;
-    cv::putText(img, spec.rows[r], {left - 6 - textWidth(spec.rows[r]), y + cell - 5}, font, fs,
+    cv::putText(img, spec.rows[r], {left - 6 - textWidth(spec.rows[r], fs), y + cell - 5}, font, fs,
                 cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
     int total = 0;
     for (int c = 0; c < nc; ++c) total += spec.counts[r][c];
@@ -183,7 +181,7 @@ cv::Mat drawConfusionMatrix(const ConfusionSpec& spec) {
       cv::rectangle(img, box, cv::Scalar(225, 225, 225), 1);
       if (n > 0) {
         const std::string t = std::to_string(n);
-        cv::putText(img, t, {box.x + (cell - textWidth(t)) / 2, box.y + cell - 5}, font, fs,
+        cv::putText(img, t, {box.x + (cell - textWidth(t, fs)) / 2, box.y + cell - 5}, font, fs,
                     f > 0.5 ? cv::Scalar(255, 255, 255) : cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
       }
     }

@@ -140,8 +140,8 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
   }
   std::vector<unsigned char> mask;
   // OpenCV's RANSAC stops early only once it has a good model, so a photo that does not verify
-  // (most of those tried) ran all ransac_iterations: 7 of a frame's ~70 ms. The bound stops it
-  // once a min_inliers model would have been found with the same confidence.
+  // ran all ransac_iterations (329 of 518 calls on 100 val frames). The bound stops it once a
+  // min_inliers model would have been found with the same confidence.
   constexpr double kConfidence = 0.995;
   const int iterations = ransacIterations(static_cast<int>(src.size()), p.min_inliers,
                                           p.ransac_iterations, kConfidence);

@@ -11,11 +11,7 @@ expect(2 "--set 'oops': expected key=value" --set oops probe folder:///x)
 # A folder with one good frame and one corrupt one: probe reports both, JSON on stdout.
 file(WRITE ${WORK}/frames/b.jpg "not a jpeg")
 file(COPY ${CMAKE_CURRENT_LIST_DIR}/fixtures/tiny.png DESTINATION ${WORK}/frames)
-execute_process(COMMAND ${SN} --json probe folder://${WORK}/frames --frames 5
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "probe of a folder failed (${rc}):\n${out}\n${err}")
-endif()
+run_ok(out err --json probe folder://${WORK}/frames --frames 5)
 string(JSON received GET "${out}" received)
 string(JSON dropped GET "${out}" dropped)
 string(JSON kind GET "${out}" kind)

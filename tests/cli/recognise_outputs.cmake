@@ -12,19 +12,11 @@ file(COPY ${L}/Tropicana-Apple-Juice/Tropicana-Apple-Juice_001.jpg
 file(COPY ${L}/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg DESTINATION ${WORK}/eval/Oatly-Oat-Milk)
 file(COPY ${CMAKE_CURRENT_LIST_DIR}/fixtures/tiny.png DESTINATION ${WORK}/eval/Not-In-The-Model)
 
-execute_process(COMMAND ${SN} --json train --landmarks ${L} -o ${WORK}/demo.slm
-                RESULT_VARIABLE rc OUTPUT_QUIET ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "train failed (${rc}):\n${err}")
-endif()
+run_ok(out err --json train --landmarks ${L} -o ${WORK}/demo.slm)
 
 # train's per-class report: classes of fewer than 3 photos are flagged (the eval folder as a set:
 # 2 + 1 photos; the tiny fixture has too few keypoints and its class is dropped).
-execute_process(COMMAND ${SN} --json train --landmarks ${WORK}/eval -o ${WORK}/small.slm
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "train of the small set failed (${rc}):\n${out}\n${err}")
-endif()
+run_ok(out err --json train --landmarks ${WORK}/eval -o ${WORK}/small.slm)
 string(JSON weak GET "${out}" weak_classes)
 string(JSON oatly_photos GET "${out}" per_class Oatly-Oat-Milk photos)
 string(JSON oatly_warning GET "${out}" per_class Oatly-Oat-Milk warnings 0)
@@ -51,12 +43,8 @@ function(png_size file out_w out_h)
   set(${out_h} ${h} PARENT_SCOPE)
 endfunction()
 
-execute_process(COMMAND ${SN} --json recognise --model ${WORK}/demo.slm --eval ${WORK}/eval
-                        --plot ${WORK}/confusion.png
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "recognise --eval --plot failed (${rc}):\n${out}\n${err}")
-endif()
+run_ok(out err --json recognise --model ${WORK}/demo.slm --eval ${WORK}/eval
+       --plot ${WORK}/confusion.png)
 string(JSON images GET "${out}" images)
 string(JSON top1 GET "${out}" top1)
 string(JSON sift GET "${out}" sift_alone_cpu_ms_mean)
@@ -71,14 +59,9 @@ if(w LESS 300 OR h LESS 150)
   message(FATAL_ERROR "confusion.png is ${w} x ${h}: too small for 3 rows and their labels")
 endif()
 
-execute_process(COMMAND ${SN} recognise --model ${WORK}/demo.slm --frame 640x480
-                        --annotate ${WORK}/annotated
-                        ${WORK}/eval/Tropicana-Apple-Juice/Tropicana-Apple-Juice_001.jpg
-                        ${WORK}/eval/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg
-                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
-if(NOT rc EQUAL 0)
-  message(FATAL_ERROR "recognise --annotate failed (${rc}):\n${out}\n${err}")
-endif()
+run_ok(out err recognise --model ${WORK}/demo.slm --frame 640x480 --annotate ${WORK}/annotated
+       ${WORK}/eval/Tropicana-Apple-Juice/Tropicana-Apple-Juice_001.jpg
+       ${WORK}/eval/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg)
 png_size(${WORK}/annotated/001_Tropicana-Apple-Juice_001.png w h)
 if(NOT w EQUAL 640 OR NOT h EQUAL 480)
   message(FATAL_ERROR "annotated frame is ${w} x ${h}, expected the 640 x 480 frame")

@@ -130,6 +130,14 @@ TEST(ExperimentVariants, SketchNoiseIsSeeded) {
   EXPECT_THROW(makeSketch(v, bad, 1), InputError);
 }
 
+// Pixels of exactly colour c: what a plot drew in that colour.
+int countColour(const cv::Mat& img, const cv::Vec3b& c) {
+  int n = 0;
+  for (int y = 0; y < img.rows; ++y)
+    for (int x = 0; x < img.cols; ++x) n += img.at<cv::Vec3b>(y, x) == c;
+  return n;
+}
+
 TEST(Plot, DrawsAxesAndSeries) {
   PlotSpec spec;
   spec.title = "t";
@@ -138,20 +146,10 @@ TEST(Plot, DrawsAxesAndSeries) {
   ASSERT_EQ(img.cols, spec.width);
   ASSERT_EQ(img.rows, spec.height);
   // Some pixels carry the first series' colour (the line was drawn).
-  int coloured = 0;
-  const cv::Vec3b c(180, 100, 30);
-  for (int y = 0; y < img.rows; ++y)
-    for (int x = 0; x < img.cols; ++x) coloured += img.at<cv::Vec3b>(y, x) == c;
-  EXPECT_GT(coloured, 50);
+  EXPECT_GT(countColour(img, cv::Vec3b(180, 100, 30)), 50);
 }
 
 TEST(Plot, ConfusionMatrixShadesByRowShareAndOutlinesTheRightAnswers) {
-  auto count = [](const cv::Mat& img, const cv::Vec3b& c) {
-    int n = 0;
-    for (int y = 0; y < img.rows; ++y)
-      for (int x = 0; x < img.cols; ++x) n += img.at<cv::Vec3b>(y, x) == c;
-    return n;
-  };
   ConfusionSpec spec;
   spec.title = "t";
   spec.rows = {"a", "b"};
@@ -161,14 +159,14 @@ TEST(Plot, ConfusionMatrixShadesByRowShareAndOutlinesTheRightAnswers) {
   const cv::Mat two = drawConfusionMatrix(spec);
   const cv::Vec3b full_row(180, 55, 30);  // b -> (none): the whole row
   const cv::Vec3b outline(40, 160, 40);   // a -> a and b -> b
-  EXPECT_GT(count(two, full_row), 100);
-  EXPECT_GT(count(two, outline), 2 * 4 * 14);
+  EXPECT_GT(countColour(two, full_row), 100);
+  EXPECT_GT(countColour(two, outline), 2 * 4 * 14);
   // Without a right answer in a row, no outline; with a third row, one cell taller.
   spec.rows.push_back("c");
   spec.counts.push_back({0, 0, 1});
   const cv::Mat three = drawConfusionMatrix(spec);
   EXPECT_EQ(three.rows, two.rows + 18);
-  EXPECT_EQ(count(three, outline), count(two, outline));
+  EXPECT_EQ(countColour(three, outline), countColour(two, outline));
 }
 
 }  // namespace

@@ -9,3 +9,14 @@ function(expect code pattern)
     message(FATAL_ERROR "sketchnav ${ARGN}: output does not match '${pattern}':\n${out}\n${err}")
   endif()
 endfunction()
+
+# run_ok(OUT ERR ARGS...): runs ${SN} ARGS, fails the calling test script unless it exits 0,
+# and returns its stdout and stderr in the variables named OUT and ERR.
+function(run_ok out_var err_var)
+  execute_process(COMMAND ${SN} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  if(NOT rc EQUAL 0)
+    message(FATAL_ERROR "sketchnav ${ARGN}: exit ${rc}, expected 0\n${out}\n${err}")
+  endif()
+  set(${out_var} "${out}" PARENT_SCOPE)
+  set(${err_var} "${err}" PARENT_SCOPE)
+endfunction()
