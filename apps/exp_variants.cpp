@@ -65,7 +65,7 @@ void keepLandmarks(Json& world, const std::vector<std::string>& keep) {
 void setClass(Json& world, const std::string& id, const std::string& cls) {
   Json& l = landmarkById(world, id);
   l["class"] = cls;
-  l["texture"] = "landmarks/" + cls + "/" + cls + "_Iconic.jpg";
+  l["texture"] = "textures/" + cls + "/" + cls + "_Iconic.jpg";
   l.erase("back_texture");
 }
 

@@ -1,5 +1,6 @@
 #include "run_harness.h"
 
+#include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
 #include <chrono>
@@ -12,6 +13,7 @@
 #include <iostream>
 #include <map>
 #include <optional>
+#include <set>
 #include <sstream>
 
 #include "sketchnav/core/error.h"
@@ -21,6 +23,7 @@
 #include "sketchnav/hw/recording.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
+#include "sketchnav/landmarks/photo_hash.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
@@ -57,6 +60,41 @@ std::string modelCachePath(const std::string& landmark_dir, const std::string& c
 }
 
 namespace {
+
+// A world texture that is one of the model's database photos (or a near-duplicate of one).
+struct TrainingTexture {
+  std::string texture, photo;
+  int distance = 0;  // [bits] perceptual-hash distance
+};
+
+std::vector<TrainingTexture> trainingTextures(const sim::World& w,
+                                              const landmarks::LandmarkModel& model) {
+  std::vector<TrainingTexture> out;
+  std::set<std::string> seen;
+  for (const auto& l : w.landmarks)
+    for (const std::string& tex : {l.texture, l.back_texture}) {
+      if (tex.empty() || !seen.insert(tex).second) continue;
+      const cv::Mat img = cv::imread(tex, cv::IMREAD_COLOR);
+      if (img.empty()) throw InputError("texture '" + tex + "' cannot be read as an image");
+      const auto hits = landmarks::findTrainingPhotos(model, img);
+      if (!hits.empty()) out.push_back({tex, hits.front().photo, hits.front().distance});
+    }
+  return out;
+}
+
+// A model trained on other classes than the world's landmarks can recognise none of them.
+void checkWorldClasses(const sim::World& w, const landmarks::LandmarkModel& model,
+                       const std::string& world_name, const std::string& model_path) {
+  if (w.landmarks.empty()) return;
+  std::string names;
+  for (const auto& l : w.landmarks) {
+    if (model.classId(l.class_name) >= 0) return;
+    if (names.find("'" + l.class_name + "'") == std::string::npos)
+      names += (names.empty() ? "'" : ", '") + l.class_name + "'";
+  }
+  throw InputError("world " + world_name + ": none of its landmark classes (" + names +
+                   ") is in the landmark model " + model_path);
+}
 
 bool looksLikePath(const std::string& s) {
   return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
@@ -392,6 +430,17 @@ Json runNavigation(const RunOptions& o) {
         });
   }
   mapsketch::validateClasses(sketch, model->classes(), sketch_path);
+  std::vector<TrainingTexture> training_textures;
+  if (simr) {
+    checkWorldClasses(simr->world(), *model, world_name, model_path);
+    training_textures = trainingTextures(simr->world(), *model);
+    for (const auto& t : training_textures)
+      log::warn("run",
+                "the world shows the model one of its training photos: this run tests the "
+                "model on its own training data, not as a real camera would",
+                {{"texture", t.texture}, {"training_photo", t.photo},
+                 {"hash_distance_bits", std::to_string(t.distance)}});
+  }
 
   // --- settings -----------------------------------------------------------------------------
   nav::NavSettings settings = nav::navSettingsFrom(o.config);
@@ -465,6 +514,10 @@ Json runNavigation(const RunOptions& o) {
   s["world"] = hardware ? "" : world_name;
   s["sketch"] = sketch_path;
   s["model"] = model_path;
+  Json tt = Json::array();
+  for (const auto& t : training_textures)
+    tt.push_back({{"texture", t.texture}, {"training_photo", t.photo}, {"distance_bits", t.distance}});
+  s["training_textures"] = tt;
   Json recognised = Json::array();
   for (const auto& l : es.landmarks)
     if (l.frames_seen > 0) recognised.push_back(l.id);

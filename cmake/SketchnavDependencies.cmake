@@ -11,7 +11,7 @@ endmacro()
 find_package(Threads REQUIRED)
 
 find_package(OpenCV QUIET COMPONENTS core imgproc imgcodecs videoio features2d calib3d flann ml
-                                      ximgproc saliency)
+                                      ximgproc saliency img_hash)
 sketchnav_require(OpenCV_FOUND "OpenCV 4 with contrib (ximgproc, saliency)"
                   "libopencv-dev libopencv-contrib-dev")
 

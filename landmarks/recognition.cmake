@@ -10,11 +10,13 @@ set(LANDMARKS_RECOGNITION_SOURCES
   ${CMAKE_CURRENT_SOURCE_DIR}/src/model_io.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/matcher_match.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/recognition_recognise.cpp
-  ${CMAKE_CURRENT_SOURCE_DIR}/src/recognition_appearance.cpp)
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/recognition_appearance.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/src/photo_hash.cpp)
 set(LANDMARKS_RECOGNITION_TESTS
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_rootsift.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_model.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_match.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_grocery.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_colour.cpp
-  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_sibling.cpp)
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_sibling.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_photo_hash.cpp)

@@ -224,7 +224,7 @@ TEST_F(UiHttp, PathTraversalIsRefused) {
 TEST(UiHttpClasses, ClassNamesWithSpacesAndSymbolsGetWorkingThumbnailUrls) {
   const std::string dir = test::tempDir("uiclasses");
   const std::string src =
-      test::sourceDir() + "/share/landmarks/Oatly-Oat-Milk/Oatly-Oat-Milk_Iconic.jpg";
+      test::sourceDir() + "/share/landmarks/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg";
   fs::create_directories(dir + "/set/Milk 2% fat");
   fs::create_directories(dir + "/set/empty");  // no image: not a class
   fs::copy_file(src, dir + "/set/Milk 2% fat/a.jpg");

@@ -29,7 +29,7 @@ using sim::Vec2;
 namespace {
 
 std::string texture(const std::string& cls) {
-  return resourcePath("landmarks/" + cls + "/" + cls + "_Iconic.jpg");
+  return resourcePath("textures/" + cls + "/" + cls + "_Iconic.jpg");
 }
 
 /// An empty rectangular room [0, w] x [0, h] with 0.1 m walls; robot at (1, h/2) facing +x.
@@ -93,7 +93,7 @@ Json minimalWorldJson() {
           {"landmarks",
            {{{"id", "L1"},
              {"class", "Oatly-Oat-Milk"},
-             {"texture", "landmarks/Oatly-Oat-Milk/Oatly-Oat-Milk_Iconic.jpg"},
+             {"texture", "textures/Oatly-Oat-Milk/Oatly-Oat-Milk_Iconic.jpg"},
              {"position", {5.9, 2}},
              {"yaw_deg", 180}}}},
           {"start", {{"x", 1}, {"y", 2}}},

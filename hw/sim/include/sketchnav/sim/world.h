@@ -168,7 +168,7 @@ struct World {
 };
 
 /// Loads and validates a world file (JSON). Texture paths are resolved relative to the world
-/// file's folder, then to share/ (so "landmarks/Oatly-Oat-Milk/Oatly-Oat-Milk_Iconic.jpg"
+/// file's folder, then to share/ (so "textures/Oatly-Oat-Milk/Oatly-Oat-Milk_Iconic.jpg"
 /// works from anywhere). Throws InputError with one line naming the file and the field:
 /// unknown keys, wrong types, overlapping walls, a landmark outside the floor, a missing
 /// texture, a pedestrian path with fewer than two points...
