@@ -461,6 +461,7 @@ Json runNavigation(const RunOptions& o) {
   settings.servo.validate();
   settings.avoid.validate();
   applyConfig(pp, o.config, "nav.perception");
+  applyConfig(pp.recognition, o.config, "landmarks.recognition");
 
   if (!o.out_dir.empty()) fs::create_directories(o.out_dir);
   RunObserver observer(o.out_dir, o.progress, simr.get(), static_cast<int>(route.sections.size()));

@@ -11,7 +11,6 @@
 
 namespace sketchnav::landmarks {
 
-
 std::uint64_t perceptualHash(const cv::Mat& image) {
   CV_Assert(!image.empty());
   // The same shrinking as the model's thumbnails (colourThumbnail), so a photo and its

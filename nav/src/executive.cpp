@@ -516,7 +516,11 @@ struct Executive::Impl {
       feat_sum += ob.timing.features_ms;
       match_sum += ob.timing.match_ms;
       std::vector<Candidate> all;
-      for (const auto& d : ob.detections) all.push_back({&d, rangeAt(d.bearing)});
+      // A detection that recognition found but no photo verified is placed by a looser match:
+      // its bearing is good enough to steer and to fix by, but a laser return along it may be
+      // a neighbour of the landmark, so it is taken for its bearing alone.
+      for (const auto& d : ob.detections)
+        all.push_back({&d, d.recognised_only ? 0.0 : rangeAt(d.bearing)});
       std::vector<bool> used(all.size(), false);
       // A landmark being tracked is expected where it was last seen, and its detection is not
       // another landmark's (landmark_stage.h: claimedByTracked).
@@ -581,7 +585,10 @@ struct Executive::Impl {
         t.last_point_range = range;
         // Far ranges may be something else along the bearing; the bearing still helps.
         const bool far = range > fixRange();
-        if (!far || s.exec.fit_bearing_only) {
+        // Fixes rest on verified geometry: the bearings of recognised-only detections are
+        // noisier by a few degrees, which a triangulation from nearly parallel rays turns into
+        // metres; they still steer the servo and keep the track.
+        if (!d.recognised_only && (!far || s.exec.fit_bearing_only)) {
           if (t.sightings.size() >= 80) t.sightings.erase(t.sightings.begin());
           Sighting sg{
               {pose.x, pose.y}, pose.theta + d.bearing, far ? 0.0 : range, far ? range : 0.0};

@@ -36,6 +36,16 @@ void PerceptionParams::validate() const {
   require(fovea_max_side >= 64, "nav.perception.fovea_max_side", "must be >= 64 px");
   require(fovea_max_features >= 0, "nav.perception.fovea_max_features", "must be >= 0");
   require(fovea_max_looks >= 0, "nav.perception.fovea_max_looks", "must be >= 0");
+  require(recognise_windows >= 0 && recognise_windows <= max_windows,
+          "nav.perception.recognise_windows", "must be in [0, max_windows]");
+  require(position_min_inliers >= 4 && position_min_inliers <= min_inliers,
+          "nav.perception.position_min_inliers", "must be in [4, min_inliers] (a homography)");
+  require(window_side >= 64 && window_side <= 1024, "nav.perception.window_side",
+          "must be in [64, 1024] px");
+  require(window_margin >= 0 && window_margin <= 1, "nav.perception.window_margin",
+          "must be in [0, 1]");
+  require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
+  recognition.validate();
 }
 
 Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
@@ -112,6 +122,125 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   d.elevation = elevationOf(off, K, P.camera_pitch);
   return true;
 }
+// Indices of the frame keypoints inside `box` (empty box = the whole frame).
+std::vector<int> keypointsIn(const landmarks::FrameFeatures& f, const cv::Rect& box) {
+  std::vector<int> out;
+  const auto& kp = f.features.keypoints;
+  for (int i = 0; i < static_cast<int>(kp.size()); ++i)
+    if (box.area() == 0 || box.contains(cv::Point(cvRound(kp[i].pt.x), cvRound(kp[i].pt.y))))
+      out.push_back(i);
+  return out;
+}
+
+// The best BoW decision value among `class_ids` for the words inside `box`.
+float bowScore(const landmarks::LandmarkModel& model, const landmarks::FrameFeatures& f,
+               const cv::Rect& box, const std::vector<int>& class_ids) {
+  std::vector<int> words;
+  for (int i : keypointsIn(f, box))
+    if (i < static_cast<int>(f.words.size())) words.push_back(f.words[i]);
+  if (words.empty()) return -1e9f;
+  const auto d =
+      model.classifier().decision(landmarks::bowHistogram(words, model.vocabulary().idf()));
+  float best = -1e9f;
+  for (int c : class_ids)
+    if (c >= 0 && c < static_cast<int>(d.size())) best = std::max(best, d[c]);
+  return best;
+}
+
+// A crop of the full-resolution frame scaled so its longer side is `side` px, recognised on
+// its own features (a landmark a few dozen pixels wide in the frame gets the pixels SIFT needs);
+// when the answer is one of `classes`, matched for its position (min_inliers, else
+// position_min_inliers) and mapped back to frame pixels. False when it gives no detection (not
+// recognised as a looked-for class, or no match to place it).
+bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, const cv::Rect& crop,
+                 int side, const std::vector<std::string>& classes, const hw::Intrinsics& K,
+                 const PerceptionParams& P, Detection& d) {
+  const double scale = static_cast<double>(side) / std::max(crop.width, crop.height);
+  cv::Mat patch;
+  cv::resize(img(crop), patch, cv::Size(), scale, scale,
+             scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
+  landmarks::FeatureParams fp = model.params().features;
+  fp.max_image_side = std::max({64, patch.cols, patch.rows});  // already at the chosen size
+  fp.max_features = P.window_max_features;
+  const auto feats = landmarks::computeFrameFeatures(model, patch, fp);
+  const auto recs = landmarks::recogniseWindows(model, feats, {cv::Rect()}, 1, P.recognition);
+  if (recs.empty() || recs[0].empty() || recs[0][0].rejected) return false;
+  const auto& r = recs[0][0];
+  if (std::find(classes.begin(), classes.end(), r.class_name) == classes.end()) return false;
+  landmarks::MatchParams mp = matchParams(P);
+  auto m = landmarks::match(model, feats, cv::Rect(), r.class_name, mp);
+  if (!m.matched) {
+    mp.min_inliers = P.position_min_inliers;
+    m = landmarks::match(model, feats, cv::Rect(), r.class_name, mp);
+  }
+  bool placed = false;
+  if (m.matched) {
+    const double sx = static_cast<double>(patch.cols) / crop.width,
+                 sy = static_cast<double>(patch.rows) / crop.height;
+    for (auto& p : m.x_t)
+      p = {static_cast<float>(crop.x + p.x / sx), static_cast<float>(crop.y + p.y / sy)};
+    const cv::Mat A = (cv::Mat_<double>(3, 3) << 1 / sx, 0, crop.x, 0, 1 / sy, crop.y, 0, 0, 1);
+    m.H = A * m.H;
+    m.window = crop;
+    placed = toDetection(m, r.class_name, crop, img.cols, K, P, d);
+  }
+  // Without geometry there is no position: a window's centre is not the landmark's (a window
+  // may hold much more than the landmark), and a wrong bearing misleads the route refit.
+  if (!placed) return false;
+  d.inliers = std::max(d.inliers, r.inliers);
+  d.recognised_only = d.inliers < P.min_inliers;
+  // A homography from fewer than min_inliers inliers places the landmark's column but not
+  // the photo's centre well enough to range it by its elevation.
+  if (d.recognised_only) d.elevation = NAN;
+  if (d.confidence <= 0) d.confidence = 0.5f * r.colour_probability;
+  return true;
+}
+
+// The recognition stage: the `windows` ranked by the looked-for classes' BoW score on the
+// frame's words (objectness order among equal scores), the best recognise_windows of them
+// examined at window_side px (examineCrop).
+std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, const cv::Mat& img,
+                                       const landmarks::FrameFeatures& feats,
+                                       const std::vector<cv::Rect>& windows,
+                                       const std::vector<std::string>& classes,
+                                       const hw::Intrinsics& K, const PerceptionParams& P,
+                                       int& recognised) {
+  std::vector<Detection> out;
+  if (P.recognise_windows <= 0 || windows.empty()) return out;
+  std::vector<int> ids;
+  for (const auto& c : classes) ids.push_back(model.classId(c));
+  std::vector<std::pair<float, int>> ranked;
+  for (int i = 0; i < static_cast<int>(windows.size()); ++i)
+    ranked.push_back({bowScore(model, feats, windows[i], ids), i});
+  std::stable_sort(ranked.begin(), ranked.end(),
+                   [](const auto& a, const auto& b) { return a.first > b.first; });
+  const cv::Rect frame_rect(0, 0, img.cols, img.rows);
+  for (int i = 0; i < std::min<int>(P.recognise_windows, ranked.size()); ++i) {
+    const cv::Rect& w = windows[ranked[i].second];
+    // A margin round the window: objectness windows often clip the object's border.
+    const int mx = static_cast<int>(P.window_margin * w.width),
+              my = static_cast<int>(P.window_margin * w.height);
+    const cv::Rect crop =
+        cv::Rect(w.x - mx, w.y - my, w.width + 2 * mx, w.height + 2 * my) & frame_rect;
+    if (crop.width < 8 || crop.height < 8) continue;
+    ++recognised;
+    Detection d;
+    if (examineCrop(model, img, crop, P.window_side, classes, K, P, d)) out.push_back(d);
+  }
+  return out;
+}
+
+// Adds `d` to `found` unless it is the same landmark as one there (overlapping windows or the
+// same column): then the one with more inliers stays.
+void mergeDetection(std::vector<Detection>& found, const Detection& d, double merge_iou) {
+  for (auto& f : found)
+    if (f.class_name == d.class_name &&
+        (iou(f.window, d.window) > merge_iou || std::abs(f.x_t - d.x_t) < 0.03)) {
+      if (d.inliers > f.inliers) f = d;
+      return;
+    }
+  found.push_back(d);
+}
 }  // namespace
 
 Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
@@ -151,16 +280,18 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
           box.area() > 0 ? box : cv::Rect(0, 0, frame.image.cols, frame.image.rows);
       if (!toDetection(m, cls, window, frame.image.cols, K, P, d)) continue;
       // The same landmark seen through overlapping windows is one detection (most inliers).
-      bool merged = false;
-      for (auto& f : found)
-        if (iou(f.window, d.window) > P.merge_iou || std::abs(f.x_t - d.x_t) < 0.03) {
-          if (d.inliers > f.inliers) f = d;
-          merged = true;
-          break;
-        }
-      if (!merged) found.push_back(d);
+      mergeDetection(found, d, P.merge_iou);
     }
     ob.detections.insert(ob.detections.end(), found.begin(), found.end());
+  }
+  {
+    const auto tr = clk::now();
+    std::vector<cv::Rect> ranked_boxes;
+    for (const auto& w : windows) ranked_boxes.push_back(w.box);
+    const auto recognised = recogniseRanked(model, frame.image, feats, ranked_boxes, classes, K, P,
+                                            ob.timing.recognised);
+    for (const auto& d : recognised) mergeDetection(ob.detections, d, P.merge_iou);
+    ob.timing.recognise_ms = msSince(tr);
   }
   std::sort(ob.detections.begin(), ob.detections.end(),
             [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
@@ -230,6 +361,17 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
     fp.max_features = P.fovea_max_features;
     const auto feats = landmarks::computeFrameFeatures(model, patch, fp);
     auto m = landmarks::match(model, feats, cv::Rect(), l.class_name, mp);
+    if (!m.matched && P.recognise_windows > 0) {
+      // The crop recognised as the looked-for class: positioned by a looser match.
+      const auto recs = landmarks::recogniseWindows(model, feats, {cv::Rect()}, 1, P.recognition);
+      ++ob.timing.recognised;
+      if (!recs.empty() && !recs[0].empty() && !recs[0][0].rejected &&
+          recs[0][0].class_name == l.class_name) {
+        landmarks::MatchParams loose = mp;
+        loose.min_inliers = P.position_min_inliers;
+        m = landmarks::match(model, feats, cv::Rect(), l.class_name, loose);
+      }
+    }
     if (!m.matched) continue;
 
     // Crop pixels -> full-frame pixels (per axis: resize rounds the scaled size).
@@ -246,6 +388,8 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
     // The window drawn for it: the matched keypoints' extent, inside the crop.
     const cv::Rect box = cv::boundingRect(m.x_t) & crop;
     if (!toDetection(m, l.class_name, box.area() > 0 ? box : crop, img.cols, K, P, d)) continue;
+    d.recognised_only = d.inliers < P.min_inliers;
+    if (d.recognised_only) d.elevation = NAN;  // as in examineCrop()
     ob.detections.push_back(d);
   }
   std::sort(ob.detections.begin(), ob.detections.end(),

@@ -22,7 +22,8 @@ int hashDistance(std::uint64_t a, std::uint64_t b);
 
 /// [bits] default Hamming radius for "near-duplicate": copies that are re-encoded, resized or
 /// brightened lie within it, and crops of up to ~2 % per side; distinct photos (even of the same
-/// product) almost all lie beyond it (distances measured on the grocery photos in doc/simulator.md).
+/// product) almost all lie beyond it (distances measured on the grocery photos in
+/// doc/simulator.md).
 constexpr int kNearDuplicateBits = 10;
 
 struct TrainingPhotoHit {

@@ -12,6 +12,7 @@
 #include <opencv2/core/types.hpp>
 
 #include "sketchnav/hw/types.h"
+#include "sketchnav/landmarks/recognition.h"
 
 namespace sketchnav::landmarks {
 class LandmarkModel;
@@ -33,13 +34,18 @@ struct Detection {
   // where the laser cannot (locateLandmark: an elevated carton, the laser passing under it).
   double elevation = NAN;
   int photo = -1;  // database photo matched: elevations compare within one photo (its framing)
+  // true: found by recognition (votes, BoW, colour) with fewer than min_inliers inliers; its
+  // column is from a looser match, and it has no elevation (NaN).
+  bool recognised_only = false;
 };
 
 struct PerceptionTiming {
   double objectness_ms = 0, features_ms = 0, match_ms = 0, total_ms = 0;  // wall time
-  double fovea_ms = 0;  // wall time of the foveal second looks (part of total_ms)
-  int windows = 0;      // objectness windows examined
-  int fovea_looks = 0;  // foveal crops examined (a hinted class missed by the normal pass)
+  double fovea_ms = 0;      // wall time of the foveal second looks (part of total_ms)
+  double recognise_ms = 0;  // wall time of the recognition of ranked windows (part of match_ms)
+  int recognised = 0;       // windows recognised (recognise_windows at most)
+  int windows = 0;          // objectness windows examined
+  int fovea_looks = 0;      // foveal crops examined (a hinted class missed by the normal pass)
 };
 
 /// A class to look for, with where the executive expects it (from the sketch). Without a
@@ -109,6 +115,21 @@ struct PerceptionParams {
   int fovea_max_features = 1000;   // strongest keypoints kept in the crop (0 = all)
   int fovea_max_looks = 1;         // second looks per frame at most, in hint order (the
                                    // executive lists the landmark it servos on first)
+  // Recognition in the loop (the paper's pipeline): windows are ranked by the looked-for
+  // classes' BoW score (the SVM decision on the window's visual words), and the best
+  // recognise_windows of them are recognised (landmarks::recogniseWindows: votes, BoW, colour
+  // layout and verification) on a crop of the full-resolution frame scaled to window_side px.
+  // A window whose answer is a looked-for class is a detection even when no database photo
+  // reaches min_inliers (a view the photos do not show closely): its position then comes from a
+  // match needing only position_min_inliers; without one it gives no detection (a window's
+  // centre is no position). The foveal second look is recognised the same way. 0 = matching
+  // alone.
+  int recognise_windows = 4;
+  int position_min_inliers = 6;   // RANSAC inliers for the servo position of a recognised window
+  int window_side = 256;          // [px] a recognised window is cropped and scaled to this side
+  double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
+  int window_max_features = 500;  // strongest keypoints kept in the crop (0 = all)
+  landmarks::RecognitionParams recognition;  // "landmarks.recognition.*"
   template <class B>
   void bind(B& b) {
     b("max_windows", max_windows);
@@ -132,6 +153,11 @@ struct PerceptionParams {
     b("fovea_max_side", fovea_max_side);
     b("fovea_max_features", fovea_max_features);
     b("fovea_max_looks", fovea_max_looks);
+    b("recognise_windows", recognise_windows);
+    b("position_min_inliers", position_min_inliers);
+    b("window_side", window_side);
+    b("window_margin", window_margin);
+    b("window_max_features", window_max_features);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
 };
