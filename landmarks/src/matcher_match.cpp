@@ -1,4 +1,5 @@
 #include <opencv2/calib3d.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
@@ -363,12 +364,21 @@ ServoOffset servoOffset(const MatchResult& m, int frame_width) {
     if (std::abs(w) > 1e-9) {
       o.centre_u = (H.at<double>(0, 0) * dcx + H.at<double>(0, 1) * dcy + H.at<double>(0, 2)) / w;
       o.centre_v = (H.at<double>(1, 0) * dcx + H.at<double>(1, 1) * dcy + H.at<double>(1, 2)) / w;
-      u = static_cast<float>(o.centre_u);
       const double det =
           H.at<double>(0, 0) * H.at<double>(1, 1) - H.at<double>(0, 1) * H.at<double>(1, 0);
       scale = std::sqrt(std::abs(det)) / std::abs(w);
+      // The object's column: the centre of the matched part of the database photo through H.
+      // Not the photo's centre: a user's photo frames the object anywhere (a carton held in a
+      // hand, on a shelf), so its centre may be far from the object's.
+      const cv::Rect2f part = cv::boundingRect(m.x_d);
+      const double px = part.x + 0.5 * part.width, py = part.y + 0.5 * part.height;
+      const double wp = H.at<double>(2, 0) * px + H.at<double>(2, 1) * py + H.at<double>(2, 2);
+      if (std::abs(wp) > 1e-9)
+        u = static_cast<float>(
+            (H.at<double>(0, 0) * px + H.at<double>(0, 1) * py + H.at<double>(0, 2)) / wp);
       // The centre may fall outside a partly visible object's frame, but not absurdly far.
-      h_ok = std::isfinite(u) && u > -2.0f * frame_width && u < 3.0f * frame_width;
+      h_ok = std::abs(wp) > 1e-9 && std::isfinite(u) && u > -2.0f * frame_width &&
+             u < 3.0f * frame_width;
     }
   }
   std::vector<float> xs, paper;

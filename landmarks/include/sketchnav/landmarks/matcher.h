@@ -134,16 +134,18 @@ MatchResult matchPhoto(const LandmarkModel& model, const FrameFeatures& frame,
 /// What the servo needs from a match, in frame pixels.
 struct ServoOffset {
   bool valid = false;
-  float object_u = 0;         // [px] frame column of the matched object's centre
+  float object_u = 0;  // [px] frame column of the matched object's centre: the centre of the
+                       // inliers' extent in the database photo through H
   float offset_px = 0;        // [px] object_u − frame_width / 2 (> 0: object right of centre)
   float paper_offset_px = 0;  // [px] median over inliers of (x_t − frame_cx) − s (x_d − db_cx),
                               //      s = frame/database scale from H: the paper's x_t − x_d
-  // [px] the database photo's centre through H, unrounded (NaN without a usable H): where
-  // object_u comes from when H is sane, and the row an elevation angle is read from.
+  // [px] the database photo's centre through H, unrounded (NaN without a usable H): the row an
+  // elevation angle is read from (the same point of a photo in every match of it).
   double centre_u = NAN, centre_v = NAN;
 };
-/// Robust offsets from a match (the homography-projected database centre; falls back to
-/// the median inlier column when the homography is degenerate). Invalid when not matched.
+/// Robust offsets from a match (the homography-projected centre of the matched part of the
+/// database photo; falls back to the median inlier column when the homography is degenerate).
+/// Invalid when not matched.
 ServoOffset servoOffset(const MatchResult& m, int frame_width);
 
 }  // namespace sketchnav::landmarks
