@@ -203,10 +203,10 @@ int makeBenchSequences(const Args& args, GlobalOptions& g) {
   if (o.data_dir.empty()) {
     const char* env = std::getenv("SKETCHNAV_DATA");
     // beside the source tree's share/ as ../shared/data (the project's data convention)
-    o.data_dir = env && *env ? std::string(env)
-                             : (fs::path(resourceDir()).parent_path().parent_path() / "shared" /
-                                "data")
-                                   .string();
+    o.data_dir =
+        env && *env
+            ? std::string(env)
+            : (fs::path(resourceDir()).parent_path().parent_path() / "shared" / "data").string();
   }
   if (!fs::is_directory(o.data_dir))
     throw InputError("--data " + o.data_dir + ": no such folder (give --data or SKETCHNAV_DATA)");
@@ -224,8 +224,8 @@ int makeBenchSequences(const Args& args, GlobalOptions& g) {
   if (g.json)
     printJson({{"sequences", names}, {"out", o.out_dir}, {"split", bench::toString(o.split)}});
   else
-    std::cout << "wrote " << names.size() << " sequences (" << bench::toString(o.split)
-              << ") to " << o.out_dir << "\n";
+    std::cout << "wrote " << names.size() << " sequences (" << bench::toString(o.split) << ") to "
+              << o.out_dir << "\n";
   return 0;
 }
 
@@ -240,7 +240,8 @@ int runEval(const Args& args, GlobalOptions& g) {
       dirs.push_back(e.path());
   std::sort(dirs.begin(), dirs.end());
   if (dirs.empty())
-    throw InputError("--eval " + root.string() + ": no sequence folders (truth.csv + sequence.json)");
+    throw InputError("--eval " + root.string() +
+                     ": no sequence folders (truth.csv + sequence.json)");
   const double hfov = args.getDouble("hfov");
   if (!(hfov > 1 && hfov < 179)) throw InputError("--hfov must be in (1, 179) degrees");
   const long max_frames = args.getInt("max-frames");
@@ -308,8 +309,8 @@ int runEval(const Args& args, GlobalOptions& g) {
           << seqs[s].motion << ',' << seqs[s].absent << ','
           << (sc.expected.empty() ? "-" : sc.expected) << ',' << r.turn << ',' << sc.found << ','
           << opt(sc.truth.u) << ',' << opt(sc.u_found) << ',' << opt(sc.truth.yaw_deg) << ','
-          << opt(sc.truth.width_px) << ',' << sc.truth.visible << ',' << r.inliers << ','
-          << r.ms << '\n';
+          << opt(sc.truth.width_px) << ',' << sc.truth.visible << ',' << r.inliers << ',' << r.ms
+          << '\n';
     }
     const Json sj = bench::summarise(mine);
     std::cerr << dirs[s].filename().string() << " (" << seqs[s].target
@@ -351,16 +352,16 @@ int runEval(const Args& args, GlobalOptions& g) {
     printJson(result);
   } else {
     auto pct = [](const Json& v) {
-      return v.is_number() ? std::to_string(static_cast<int>(std::lround(100 * v.get<double>()))) + " %"
-                           : std::string("-");
+      return v.is_number()
+                 ? std::to_string(static_cast<int>(std::lround(100 * v.get<double>()))) + " %"
+                 : std::string("-");
     };
     std::cout << dirs.size() << " sequences, " << result["frames"] << " frames ("
               << result["scored_frames"] << " scored): agreement " << pct(result["agreement"])
               << ", target found " << pct(result["found_rate"]) << ", reported on "
               << result["false_reports"] << " / " << result["absent_frames"]
-              << " target-absent frames, bearing error median "
-              << result["bearing_error_px_median"] << " px, "
-              << result["ms_per_frame_median"] << " ms per frame (median)\n";
+              << " target-absent frames, bearing error median " << result["bearing_error_px_median"]
+              << " px, " << result["ms_per_frame_median"] << " ms per frame (median)\n";
     for (const char* key : {"by_yaw_deg", "by_width_px"})
       for (const auto& b : result[key])
         std::cout << "  " << key << " " << b["lo"] << "-" << b["hi"] << ": found "
@@ -401,10 +402,12 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("absent", "with --make-sequences: target-absent sequences", "4")
       .option("seq-frames", "with --make-sequences: frames per sequence", "20")
       .option("classes", "with --make-sequences: comma-separated target classes (default: all)")
-      .option("data", "with --make-sequences: the shared data folder "
-                      "(default: $SKETCHNAV_DATA or ../shared/data)")
-      .option("eval", "run every sequence folder (truth.csv + sequence.json) in DIR and report "
-                      "the aggregate (eval.json, eval.csv, found_rate.png)");
+      .option("data",
+              "with --make-sequences: the shared data folder "
+              "(default: $SKETCHNAV_DATA or ../shared/data)")
+      .option("eval",
+              "run every sequence folder (truth.csv + sequence.json) in DIR and report "
+              "the aggregate (eval.json, eval.csv, found_rate.png)");
   if (!args.parse(argv)) return 0;
   if (!args.get("make-fixture").empty()) {
     std::vector<double> ds;
@@ -558,14 +561,15 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
           agree, truth_n, truth_n ? 100.0 * agree / truth_n : 0.0, agree_detected, truth_detected,
           truth_detected ? 100.0 * agree_detected / truth_detected : 0.0);
       const Json b = bench::summarise(scores);
-      std::printf("target found on %d / %d scored frames; reported on %d / %d target-absent "
-                  "frames; bearing error median %s px; %.0f ms per frame (median)\n",
-                  b["found"].get<int>(), b["scored_frames"].get<int>(),
-                  b["false_reports"].get<int>(), b["absent_frames"].get<int>(),
-                  b["bearing_error_px_median"].is_number()
-                      ? std::to_string(b["bearing_error_px_median"].get<double>()).c_str()
-                      : "-",
-                  b["ms_per_frame_median"].get<double>());
+      std::printf(
+          "target found on %d / %d scored frames; reported on %d / %d target-absent "
+          "frames; bearing error median %s px; %.0f ms per frame (median)\n",
+          b["found"].get<int>(), b["scored_frames"].get<int>(), b["false_reports"].get<int>(),
+          b["absent_frames"].get<int>(),
+          b["bearing_error_px_median"].is_number()
+              ? std::to_string(b["bearing_error_px_median"].get<double>()).c_str()
+              : "-",
+          b["ms_per_frame_median"].get<double>());
       for (const auto& [e, m] : confusion) {
         std::cout << "  expected " << e << ":";
         for (const auto& [gg, cnt] : m) std::cout << " " << gg << " " << cnt;

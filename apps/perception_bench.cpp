@@ -40,7 +40,9 @@ std::array<cv::Point3d, 4> Poster::corners() const {
   return {centre - a - b, centre + a - b, centre + a + b, centre - a + b};
 }
 
-cv::Point3d Poster::normal() const { return {std::sin(yaw), 0, -std::cos(yaw)}; }
+cv::Point3d Poster::normal() const {
+  return {std::sin(yaw), 0, -std::cos(yaw)};
+}
 
 PosterView viewPoster(const PinholeCamera& cam, const Poster& poster, cv::Size photo) {
   PosterView v;
@@ -49,8 +51,10 @@ PosterView viewPoster(const PinholeCamera& cam, const Poster& poster, cv::Size p
     if (!cam.project(c3[i], v.quad[i])) return v;
   // Photo pixel centres: the photo's corners are at -0.5 and size - 0.5.
   const double w = photo.width, h = photo.height;
-  const std::vector<cv::Point2f> src{
-      {-0.5f, -0.5f}, {float(w - 0.5), -0.5f}, {float(w - 0.5), float(h - 0.5)}, {-0.5f, float(h - 0.5)}};
+  const std::vector<cv::Point2f> src{{-0.5f, -0.5f},
+                                     {float(w - 0.5), -0.5f},
+                                     {float(w - 0.5), float(h - 0.5)},
+                                     {-0.5f, float(h - 0.5)}};
   std::vector<cv::Point2f> dst;
   for (const auto& q : v.quad) dst.emplace_back(float(q.x), float(q.y));
   v.H = cv::getPerspectiveTransform(src, dst);
@@ -74,7 +78,9 @@ Split parseSplit(const std::string& s) {
   if (s == "heldout") return Split::HeldOut;
   throw InputError("--split " + s + ": must be dev or heldout");
 }
-const char* toString(Split s) { return s == Split::Dev ? "dev" : "heldout"; }
+const char* toString(Split s) {
+  return s == Split::Dev ? "dev" : "heldout";
+}
 
 namespace {
 
@@ -104,7 +110,9 @@ std::map<std::string, std::vector<std::string>> classPhotos(const fs::path& root
   return m;
 }
 
-std::string brand(const std::string& cls) { return cls.substr(0, cls.find('-')); }
+std::string brand(const std::string& cls) {
+  return cls.substr(0, cls.find('-'));
+}
 
 cv::Mat readImage(const std::string& path) {
   cv::Mat m = cv::imread(path, cv::IMREAD_COLOR);
@@ -118,10 +126,11 @@ double polygonArea(const std::vector<cv::Point2f>& p) {
 
 // Share of the quad's area inside the frame.
 double insideShare(const std::array<cv::Point2d, 4>& quad, cv::Size frame) {
-  std::vector<cv::Point2f> q, r{{0, 0},
-                                {float(frame.width), 0},
-                                {float(frame.width), float(frame.height)},
-                                {0, float(frame.height)}},
+  std::vector<cv::Point2f> q,
+      r{{0, 0},
+        {float(frame.width), 0},
+        {float(frame.width), float(frame.height)},
+        {0, float(frame.height)}},
       inter;
   for (const auto& p : quad) q.emplace_back(float(p.x), float(p.y));
   const double a = polygonArea(q);
@@ -130,7 +139,8 @@ double insideShare(const std::array<cv::Point2d, 4>& quad, cv::Size frame) {
   return std::clamp(polygonArea(inter) / a, 0.0, 1.0);
 }
 
-// Pastes `img` warped by H over `frame` (bilinear, alpha from the warped mask).
+}  // namespace
+
 void pasteWarped(cv::Mat& frame, const cv::Mat& img, const cv::Mat& H) {
   cv::Mat warped, mask;
   cv::warpPerspective(img, warped, H, frame.size(), cv::INTER_LINEAR, cv::BORDER_CONSTANT);
@@ -144,6 +154,8 @@ void pasteWarped(cv::Mat& frame, const cv::Mat& img, const cv::Mat& H) {
   cv::Mat out = f32.mul(cv::Scalar(1, 1, 1) - m3) + w32.mul(m3);
   out.convertTo(frame, CV_8UC3);
 }
+
+namespace {
 
 struct Pools {
   std::map<std::string, std::vector<std::string>> photos;  // class -> photos of this split
@@ -198,7 +210,8 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
   const int total = opt.present + opt.absent;
   for (int i = 0; i < total; ++i) {
     const int seed = opt.seed + i;
-    std::mt19937 rng(static_cast<std::uint32_t>(seed) * 2654435761u + (opt.split == Split::Dev ? 0 : 7));
+    std::mt19937 rng(static_cast<std::uint32_t>(seed) * 2654435761u +
+                     (opt.split == Split::Dev ? 0 : 7));
     auto U = [&](double a, double b) { return std::uniform_real_distribution<double>(a, b)(rng); };
     auto pick = [&](const std::vector<std::string>& v) -> const std::string& {
       return v[std::uniform_int_distribution<size_t>(0, v.size() - 1)(rng)];
@@ -216,7 +229,8 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
     }
     const std::string photo_path = pick(pools.photos.at(shown));
     cv::Mat photo = readImage(photo_path);
-    const cv::Mat bg = readImage(pick(pools.backgrounds));
+    const std::string bg_path = pick(pools.backgrounds);
+    const cv::Mat bg = readImage(bg_path);
     // Appearance: yaw stratified over the four bins for the target sequences; width bins
     // cycle for the panning ones.
     const int yb = absent ? static_cast<int>(U(0, 4)) : (k / 2) % 4;
@@ -233,8 +247,10 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
       cv::Rect r;
       const int side = static_cast<int>(U(0, 3));
       if (side == 0) r = {0, 0, int(photo.cols * occ_share), photo.rows};
-      if (side == 1) r = {photo.cols - int(photo.cols * occ_share), 0, int(photo.cols * occ_share), photo.rows};
-      if (side == 2) r = {0, photo.rows - int(photo.rows * occ_share), photo.cols, int(photo.rows * occ_share)};
+      if (side == 1)
+        r = {photo.cols - int(photo.cols * occ_share), 0, int(photo.cols * occ_share), photo.rows};
+      if (side == 2)
+        r = {0, photo.rows - int(photo.rows * occ_share), photo.cols, int(photo.rows * occ_share)};
       cv::Mat patch;
       cv::resize(tex, patch, r.size());
       patch.copyTo(photo(r));
@@ -297,8 +313,8 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
         const double zoom = Zb / (Zb - cam.pos.z);
         const double cpx = 0.5 * pano.cols + f * (cam.pan - 0.5 * (pan_lo + pan_hi));
         const double cpy = 0.5 * pano.rows;
-        const cv::Mat M = (cv::Mat_<double>(2, 3) << zoom, 0, cam.cx - zoom * cpx, 0, zoom,
-                           cam.cy - zoom * cpy);
+        const cv::Mat M =
+            (cv::Mat_<double>(2, 3) << zoom, 0, cam.cx - zoom * cpx, 0, zoom, cam.cy - zoom * cpy);
         cv::warpAffine(pano, img, M, fsz, cv::INTER_LINEAR, cv::BORDER_REFLECT);
       }
       const PosterView pv = viewPoster(cam, poster, photo.size());
@@ -326,7 +342,9 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
       std::string expected = "-";
       if (scored) {
         const servo::TurnCommand cmd = law.compute((pv.centre.x - cam.cx) / f, 0.0);
-        expected = cmd.state == servo::Turn::Left ? "L" : cmd.state == servo::Turn::Right ? "R" : "S";
+        expected = cmd.state == servo::Turn::Left    ? "L"
+                   : cmd.state == servo::Turn::Right ? "R"
+                                                     : "S";
       }
       truth << fname << "," << expected << "\n";
       frames.push_back({{"frame", fname},
@@ -338,8 +356,9 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
                         {"v", pv.centre.y},
                         {"yaw_deg", pv.yaw_deg},
                         {"width_px", pv.width_px},
-                        {"quad", {pv.quad[0].x, pv.quad[0].y, pv.quad[1].x, pv.quad[1].y,
-                                  pv.quad[2].x, pv.quad[2].y, pv.quad[3].x, pv.quad[3].y}}});
+                        {"quad",
+                         {pv.quad[0].x, pv.quad[0].y, pv.quad[1].x, pv.quad[1].y, pv.quad[2].x,
+                          pv.quad[2].y, pv.quad[3].x, pv.quad[3].y}}});
     }
     const Json seq = {{"target", target},
                       {"shown", shown},
@@ -348,6 +367,7 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
                       {"split", toString(opt.split)},
                       {"seed", seed},
                       {"photo", fs::path(photo_path).lexically_relative(opt.data_dir).string()},
+                      {"background", fs::path(bg_path).lexically_relative(opt.data_dir).string()},
                       {"view_deg", view},
                       {"blur_sigma", blur},
                       {"noise_sigma", noise},
@@ -385,7 +405,8 @@ std::map<std::string, std::string> readTruthCsv(const std::string& path) {
     const auto c = line.find(',');
     if (c == std::string::npos) fail("expected 'frame,expected', got '" + line + "'");
     const std::string fr = trim(line.substr(0, c)), e = trim(line.substr(c + 1));
-    if (e.find(',') != std::string::npos) fail("expected 2 columns 'frame,expected', got '" + line + "'");
+    if (e.find(',') != std::string::npos)
+      fail("expected 2 columns 'frame,expected', got '" + line + "'");
     if (t.empty() && n == 1 && fr == "frame" && e == "expected") continue;  // header
     if (fr.empty()) fail("empty frame");
     std::string l = e;
@@ -446,7 +467,9 @@ double quantile(std::vector<double> v, double q) {
   std::sort(v.begin(), v.end());
   return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))];
 }
-Json num(double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); }
+Json num(double v) {
+  return std::isfinite(v) ? Json(v) : Json(nullptr);
+}
 }  // namespace
 
 Json summarise(const std::vector<FrameScore>& frames) {
@@ -454,7 +477,9 @@ Json summarise(const std::vector<FrameScore>& frames) {
       unscored_reports = 0;
   std::vector<double> bearing, ms;
   std::map<std::string, std::map<std::string, int>> confusion;
-  struct Bin { int n = 0, found = 0, agree = 0; };
+  struct Bin {
+    int n = 0, found = 0, agree = 0;
+  };
   std::vector<Bin> yb(kYawBins.size() - 1), wb(kWidthBins.size() - 1);
   for (const auto& f : frames) {
     ms.push_back(f.ms);

@@ -50,11 +50,15 @@ struct PosterView {
   cv::Mat H;                          // 3x3 CV_64F: photo pixel -> frame pixel
   cv::Point2d centre{NAN, NAN};       // the poster's centre in the frame [px] (= H * photo centre)
   double width_px = 0;                // horizontal extent of the quad [px]
-  double yaw_deg = 0;                 // angle between the poster's normal and the line to the camera
+  double yaw_deg = 0;  // angle between the poster's normal and the line to the camera
 };
 
 /// Projects `poster` (showing a photo of `photo` pixels) into `cam`.
 PosterView viewPoster(const PinholeCamera& cam, const Poster& poster, cv::Size photo);
+
+/// Pastes `img` warped by H (img pixel -> frame pixel) over `frame` (bilinear; the warped
+/// image's coverage is the alpha, so the poster's edges are anti-aliased).
+void pasteWarped(cv::Mat& frame, const cv::Mat& img, const cv::Mat& H);
 
 // ---- generator ---------------------------------------------------------------------------
 
@@ -64,13 +68,13 @@ Split parseSplit(const std::string& s);  // "dev" | "heldout"; InputError otherw
 const char* toString(Split s);
 
 struct GeneratorOptions {
-  std::string data_dir;         // the shared data folder (grocery-packages/, raccoon/, voc07-mini/)
-  std::string out_dir;          // one sub-folder per sequence is written here
+  std::string data_dir;  // the shared data folder (grocery-packages/, raccoon/, voc07-mini/)
+  std::string out_dir;   // one sub-folder per sequence is written here
   Split split = Split::Dev;
-  int seed = 1;                 // first sequence's seed; sequence i uses seed + i
-  int present = 12;             // sequences with the target (half panning, half approaching)
-  int absent = 4;               // sequences with another product instead (often a sibling)
-  int frames = 20;              // frames per sequence
+  int seed = 1;                      // first sequence's seed; sequence i uses seed + i
+  int present = 12;                  // sequences with the target (half panning, half approaching)
+  int absent = 4;                    // sequences with another product instead (often a sibling)
+  int frames = 20;                   // frames per sequence
   std::vector<std::string> classes;  // restrict targets to these classes (empty: all)
   int width = 640, height = 480;     // frame size [px]
   double hfov_deg = 60;              // horizontal field of view (replay's default)
@@ -104,10 +108,10 @@ struct FrameTruth {
   bool scored = false;
 };
 struct SequenceTruth {
-  std::string target;     // the class replay must look for
-  std::string shown;      // the class whose photo is pasted (== target unless absent)
-  bool absent = false;    // a target-absent sequence
-  std::string motion;     // "pan" | "approach"
+  std::string target;   // the class replay must look for
+  std::string shown;    // the class whose photo is pasted (== target unless absent)
+  bool absent = false;  // a target-absent sequence
+  std::string motion;   // "pan" | "approach"
   std::map<std::string, FrameTruth> frames;
 };
 SequenceTruth readSequenceJson(const std::string& path);
@@ -116,10 +120,10 @@ SequenceTruth readSequenceJson(const std::string& path);
 
 /// What replay did on one frame, and the truth for it.
 struct FrameScore {
-  std::string expected;    // "" unscored
-  std::string got;         // Left / Straight / Right / None
-  bool found = false;      // the target class was reported
-  double u_found = NAN;    // reported object centre column [px]
+  std::string expected;  // "" unscored
+  std::string got;       // Left / Straight / Right / None
+  bool found = false;    // the target class was reported
+  double u_found = NAN;  // reported object centre column [px]
   double ms = 0;
   bool has_truth_json = false;
   FrameTruth truth;
