@@ -172,10 +172,14 @@ Pools makePools(const std::string& data, Split split) {
   if (val.empty()) throw InputError((g / "val").string() + ": no photos (is --data right?)");
   Pools p;
   const int want = split == Split::Dev ? 0 : 1;
+  std::set<std::string> all;  // classes with a val/ or a catalogue photo
+  for (const auto& [c, v] : val) all.insert(c);
+  for (const auto& [c, v] : iconic) all.insert(c);
   int ci = 0;
-  for (const auto& [cls, v] : val) {
-    for (size_t j = 0; j < v.size(); ++j)
-      if (static_cast<int>(j % 2) == want) p.photos[cls].push_back(v[j]);
+  for (const auto& cls : all) {
+    if (auto it = val.find(cls); it != val.end())
+      for (size_t j = 0; j < it->second.size(); ++j)
+        if (static_cast<int>(j % 2) == want) p.photos[cls].push_back(it->second[j]);
     if (auto it = iconic.find(cls); it != iconic.end() && ci % 2 == want)
       for (const auto& f : it->second) p.photos[cls].push_back(f);
     if (!p.photos[cls].empty()) p.classes.push_back(cls);
