@@ -120,6 +120,20 @@ cv::Mat readImage(const std::string& path) {
   return m;
 }
 
+// A catalogue photo is the product on white: crop to the non-white bounding box (+3 %), so
+// the poster's width is the product's.
+cv::Mat cropWhiteMargin(const cv::Mat& img) {
+  cv::Mat minc;
+  std::vector<cv::Mat> ch;
+  cv::split(img, ch);
+  minc = cv::min(cv::min(ch[0], ch[1]), ch[2]);
+  const cv::Rect r = cv::boundingRect(minc < 235);
+  if (r.width < img.cols / 4 || r.height < img.rows / 4) return img;
+  const int m = std::max(1, static_cast<int>(0.03 * std::max(r.width, r.height)));
+  const cv::Rect g = (r + cv::Point(-m, -m) + cv::Size(2 * m, 2 * m)) & cv::Rect({}, img.size());
+  return img(g).clone();
+}
+
 double polygonArea(const std::vector<cv::Point2f>& p) {
   return p.size() < 3 ? 0.0 : std::abs(cv::contourArea(p));
 }
@@ -233,6 +247,7 @@ std::vector<std::string> makeSequences(const GeneratorOptions& opt) {
     }
     const std::string photo_path = pick(pools.photos.at(shown));
     cv::Mat photo = readImage(photo_path);
+    if (photo_path.find("_Iconic.") != std::string::npos) photo = cropWhiteMargin(photo);
     const std::string bg_path = pick(pools.backgrounds);
     const cv::Mat bg = readImage(bg_path);
     // Appearance: yaw stratified over the four bins for the target sequences; width bins
