@@ -11,9 +11,11 @@
 # Usage: [SETS="dev heldout"] [PRESENT=24 ABSENT=8 FRAMES=20] [SET_ARGS="--set k=v ..."] \
 #        bench/perception/run.sh [SKETCHNAV_BINARY] [DATA_DIR] [OUT_DIR]
 # The standard run (both sets, 64 sequences, 1280 frames) took 10.6 min of wall time (3.8 min
-# CPU) with the 2-core machine's load at ~13; ~6 min at ~270 ms per frame when less loaded. Sequences are regenerated when the generator's settings change
-# (a stamp file); the model is trained when missing: delete it after
-# changing the training code. SET_ARGS go to the evaluation (e.g. nav.perception.* settings).
+# CPU) with the 2-core machine's load at ~13; ~6 min at ~270 ms per frame when less loaded.
+# Sequences are regenerated when the generator's source or the sizes change (a stamp file);
+# the model is trained when missing: delete it after changing the training code. SET_ARGS go
+# to the evaluation (e.g. nav.perception.* settings). From a worktree outside /work/main, give
+# DATA_DIR or SKETCHNAV_DATA (../shared/data is relative to the checkout).
 set -euo pipefail
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
