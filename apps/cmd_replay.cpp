@@ -3,6 +3,8 @@
 // windows + RootSIFT matching against the target class's photos) and the servo law
 // (servo::TurnLaw), without moving anything: for testing perception + servo on recordings.
 // --make-fixture renders a sequence with known directions from the simulator.
+// --make-sequences / --eval: the perception benchmark of the real task (product photos pasted
+// into real backgrounds; apps/perception_bench.h, doc/perception-benchmark.md).
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
@@ -14,9 +16,11 @@
 #include <fstream>
 #include <iostream>
 #include <map>
+#include <optional>
 #include <sstream>
 
 #include "cli.h"
+#include "perception_bench.h"
 #include "scenario.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
@@ -96,43 +100,6 @@ class FrameSource {
   double hfov_ = 1.0;
 };
 
-std::string normaliseTurn(std::string s) {
-  std::transform(s.begin(), s.end(), s.begin(), ::tolower);
-  if (s == "l" || s == "left") return "Left";
-  if (s == "s" || s == "straight") return "Straight";
-  if (s == "r" || s == "right") return "Right";
-  if (s == "none" || s == "-") return "None";
-  return "";
-}
-
-/// Truth CSV: "frame,expected" (frame = index from 0 or the file name; expected
-/// Left / Straight / Right / None). A header line is allowed.
-std::map<std::string, std::string> readTruth(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("--truth " + path + ": cannot read");
-  std::map<std::string, std::string> t;
-  std::string line;
-  int n = 0;
-  while (std::getline(in, line)) {
-    ++n;
-    if (!line.empty() && line.back() == '\r') line.pop_back();
-    if (line.empty() || line[0] == '#') continue;
-    const auto c = line.find(',');
-    if (c == std::string::npos)
-      throw InputError(path + ":" + std::to_string(n) + ": expected 'frame,expected'");
-    const std::string f = line.substr(0, c), e = line.substr(c + 1);
-    const std::string turn = normaliseTurn(e);
-    if (turn.empty()) {
-      if (n == 1) continue;  // header
-      throw InputError(path + ":" + std::to_string(n) +
-                       ": expected must be Left, Straight, Right or None, got '" + e + "'");
-    }
-    t[f] = turn;
-  }
-  if (t.empty()) throw InputError("--truth " + path + ": no rows");
-  return t;
-}
-
 struct Row {
   long frame = 0;
   std::string name;
@@ -168,6 +135,24 @@ cv::Mat thumbnail(const cv::Mat& img, const nav::Observation& ob, const Row& r,
   if (r.turn == "Right") cv::arrowedLine(t, c, c + cv::Point(30, 0), col, 3);
   if (r.turn == "Straight") cv::arrowedLine(t, c, c + cv::Point(0, -30), col, 3);
   return t;
+}
+
+/// The benchmark's record of one frame (the sidecar, when there is one, gives u/yaw/width).
+bench::FrameScore score(const std::string& name, const std::string& expected, const Row& r,
+                        double x_t, const hw::Intrinsics& k,
+                        const std::optional<bench::SequenceTruth>& seq) {
+  bench::FrameScore s;
+  s.expected = expected;
+  s.got = r.turn;
+  s.found = r.turn != "None";
+  s.u_found = std::isfinite(x_t) ? k.cx + x_t * k.fx : NAN;
+  s.ms = r.ms;
+  if (seq) {
+    s.absent_sequence = seq->absent;
+    if (auto it = seq->frames.find(name); it != seq->frames.end())
+      s.has_truth_json = true, s.truth = it->second;
+  }
+  return s;
 }
 
 /// Renders the lab world's landmark `id` from poses where it appears at known horizontal
@@ -210,10 +195,189 @@ int makeFixture(const std::string& dir, const std::string& id, int seed,
   return 0;
 }
 
+/// --make-sequences: the benchmark generator (apps/perception_bench.cpp).
+int makeBenchSequences(const Args& args, GlobalOptions& g) {
+  bench::GeneratorOptions o;
+  o.out_dir = args.get("make-sequences");
+  o.data_dir = args.get("data");
+  if (o.data_dir.empty()) {
+    const char* env = std::getenv("SKETCHNAV_DATA");
+    // beside the source tree's share/ as ../shared/data (the project's data convention)
+    o.data_dir =
+        env && *env
+            ? std::string(env)
+            : (fs::path(resourceDir()).parent_path().parent_path() / "shared" / "data").string();
+  }
+  if (!fs::is_directory(o.data_dir))
+    throw InputError("--data " + o.data_dir + ": no such folder (give --data or SKETCHNAV_DATA)");
+  o.split = bench::parseSplit(args.get("split"));
+  o.seed = args.getInt("seed");
+  o.present = args.getInt("present");
+  o.absent = args.getInt("absent");
+  o.frames = args.getInt("seq-frames");
+  o.classes = args.getList("classes");
+  o.hfov_deg = args.getDouble("hfov");
+  if (!(o.hfov_deg > 1 && o.hfov_deg < 179)) throw InputError("--hfov must be in (1, 179) degrees");
+  applyConfig(o.servo, g.config, "servo");
+  o.servo.validate();
+  const auto names = bench::makeSequences(o);
+  if (g.json)
+    printJson({{"sequences", names}, {"out", o.out_dir}, {"split", bench::toString(o.split)}});
+  else
+    std::cout << "wrote " << names.size() << " sequences (" << bench::toString(o.split) << ") to "
+              << o.out_dir << "\n";
+  return 0;
+}
+
+/// --eval DIR: every sequence folder below DIR through perception + servo; the aggregate.
+int runEval(const Args& args, GlobalOptions& g) {
+  const fs::path root = args.get("eval");
+  if (!fs::is_directory(root)) throw InputError("--eval " + root.string() + ": no such folder");
+  std::vector<fs::path> dirs;
+  for (const auto& e : fs::directory_iterator(root))
+    if (e.is_directory() && fs::is_regular_file(e.path() / "truth.csv") &&
+        fs::is_regular_file(e.path() / "sequence.json"))
+      dirs.push_back(e.path());
+  std::sort(dirs.begin(), dirs.end());
+  if (dirs.empty())
+    throw InputError("--eval " + root.string() +
+                     ": no sequence folders (truth.csv + sequence.json)");
+  const double hfov = args.getDouble("hfov");
+  if (!(hfov > 1 && hfov < 179)) throw InputError("--hfov must be in (1, 179) degrees");
+  const long max_frames = args.getInt("max-frames");
+  // Read every truth file first: a bad one fails before any work.
+  std::vector<std::map<std::string, std::string>> truths;
+  std::vector<bench::SequenceTruth> seqs;
+  for (const auto& d : dirs) {
+    truths.push_back(bench::readTruthCsv((d / "truth.csv").string()));
+    seqs.push_back(bench::readSequenceJson((d / "sequence.json").string()));
+  }
+  auto model = std::make_shared<landmarks::LandmarkModel>(
+      landmarks::LandmarkModel::load(ensureModel(args.get("model"), true)));
+  const auto& cls = model->classes();
+  for (size_t s = 0; s < seqs.size(); ++s)
+    if (std::find(cls.begin(), cls.end(), seqs[s].target) == cls.end())
+      throw InputError((dirs[s] / "sequence.json").string() + ": target " + seqs[s].target +
+                       " is not a class of the model");
+  const std::string out = makeOutputDir(args.get("out"));
+  nav::PerceptionParams pp;
+  applyConfig(pp, g.config, "nav.perception");
+  pp.validate();
+  servo::TurnLawParams tp;
+  applyConfig(tp, g.config, "servo");
+  tp.validate();
+  nav::LandmarkPerception perception(model, pp);
+  servo::TurnLaw law(tp);
+
+  std::ofstream csv(out + "/eval.csv");
+  csv << "sequence,frame,target,motion,absent,expected,turn,found,u_true,u_found,yaw_deg,"
+         "width_px,visible,inliers,ms\n";
+  std::vector<bench::FrameScore> all;
+  std::map<std::string, std::vector<bench::FrameScore>> by_motion;
+  Json per_seq = Json::array();
+  for (size_t s = 0; s < dirs.size(); ++s) {
+    FrameSource source(dirs[s].string(), hfov, g.config);
+    std::vector<bench::FrameScore> mine;
+    cv::Mat img;
+    std::string name;
+    hw::Intrinsics k;
+    long i = 0;
+    while ((max_frames <= 0 || i < max_frames) && source.next(img, name, k)) {
+      hw::Frame f;
+      f.image = img;
+      f.seq = static_cast<std::uint64_t>(i);
+      f.source = name;
+      const auto t0 = std::chrono::steady_clock::now();
+      const nav::Observation ob = perception.observe(f, k, {seqs[s].target});
+      Row r;
+      r.ms =
+          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+      double x_t = NAN;
+      if (!ob.detections.empty()) {
+        const auto& d = ob.detections.front();
+        r.inliers = d.inliers;
+        x_t = d.x_t;
+        r.turn = servo::toString(law.compute(d.x_t, d.x_d).state);
+      }
+      ++i;
+      const auto it = truths[s].find(name);
+      if (it == truths[s].end()) continue;
+      const bench::FrameScore sc = score(name, it->second, r, x_t, k, seqs[s]);
+      mine.push_back(sc);
+      auto opt = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string(); };
+      csv << dirs[s].filename().string() << ',' << name << ',' << seqs[s].target << ','
+          << seqs[s].motion << ',' << seqs[s].absent << ','
+          << (sc.expected.empty() ? "-" : sc.expected) << ',' << r.turn << ',' << sc.found << ','
+          << opt(sc.truth.u) << ',' << opt(sc.u_found) << ',' << opt(sc.truth.yaw_deg) << ','
+          << opt(sc.truth.width_px) << ',' << sc.truth.visible << ',' << r.inliers << ',' << r.ms
+          << '\n';
+    }
+    const Json sj = bench::summarise(mine);
+    std::cerr << dirs[s].filename().string() << " (" << seqs[s].target
+              << (seqs[s].absent ? ", shows " + seqs[s].shown : std::string()) << "): agreement "
+              << (sj["agreement"].is_number() ? std::to_string(sj["agreement"].get<double>()) : "-")
+              << ", found " << sj["found"] << "/" << sj["scored_frames"] << ", false reports "
+              << sj["false_reports"] << "/" << sj["absent_frames"] << "\n";
+    per_seq.push_back({{"sequence", dirs[s].filename().string()},
+                       {"target", seqs[s].target},
+                       {"shown", seqs[s].shown},
+                       {"motion", seqs[s].motion},
+                       {"absent", seqs[s].absent},
+                       {"scored_frames", sj["scored_frames"]},
+                       {"agreement", sj["agreement"]},
+                       {"found_rate", sj["found_rate"]},
+                       {"false_reports", sj["false_reports"]},
+                       {"absent_frames", sj["absent_frames"]}});
+    auto& bm = by_motion[seqs[s].absent ? "absent" : seqs[s].motion];
+    bm.insert(bm.end(), mine.begin(), mine.end());
+    all.insert(all.end(), mine.begin(), mine.end());
+  }
+  Json result = bench::summarise(all);
+  result["sequences"] = dirs.size();
+  result["eval_dir"] = root.string();
+  for (const auto& [m, v] : by_motion) {
+    const Json j = bench::summarise(v);
+    result["by_motion"][m] = {{"frames", j["frames"]},
+                              {"scored_frames", j["scored_frames"]},
+                              {"agreement", j["agreement"]},
+                              {"found_rate", j["found_rate"]},
+                              {"false_report_rate", j["false_report_rate"]}};
+  }
+  result["per_sequence"] = per_seq;
+  result["csv"] = out + "/eval.csv";
+  result["plot"] = out + "/found_rate.png";
+  bench::writeBinPlot(result, root.filename().string(), out + "/found_rate.png");
+  std::ofstream(out + "/eval.json") << result.dump(2) << "\n";
+  if (g.json) {
+    printJson(result);
+  } else {
+    auto pct = [](const Json& v) {
+      return v.is_number()
+                 ? std::to_string(static_cast<int>(std::lround(100 * v.get<double>()))) + " %"
+                 : std::string("-");
+    };
+    std::cout << dirs.size() << " sequences, " << result["frames"] << " frames ("
+              << result["scored_frames"] << " scored): agreement " << pct(result["agreement"])
+              << ", target found " << pct(result["found_rate"]) << ", reported on "
+              << result["false_reports"] << " / " << result["absent_frames"]
+              << " target-absent frames, bearing error median " << result["bearing_error_px_median"]
+              << " px, " << result["ms_per_frame_median"] << " ms per frame (median)\n";
+    for (const char* key : {"by_yaw_deg", "by_width_px"})
+      for (const auto& b : result[key])
+        std::cout << "  " << key << " " << b["lo"] << "-" << b["hi"] << ": found "
+                  << pct(b["found_rate"]) << ", agreement " << pct(b["agreement"]) << " of "
+                  << b["frames"] << "\n";
+    std::cout << "outputs in " << out << "\n";
+  }
+  return 0;
+}
+
 int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("replay", "offline servo over an image sequence / video / camera URI; per-frame CSV",
             "--frames DIR|VIDEO|URI --target CLASS [--model M] [--truth CSV] [--out DIR]\n"
-            "       sketchnav replay --make-fixture DIR [--landmark L1]");
+            "       sketchnav replay --make-fixture DIR [--landmark L1]\n"
+            "       sketchnav replay --make-sequences DIR [--split dev|heldout] [--seed S]\n"
+            "       sketchnav replay --eval DIR [--model M] [--out DIR]");
   args.option("frames",
               "a folder of images (sorted by name), a video file, or a camera URI "
               "(folder://, video://, sim://...)")
@@ -228,7 +392,22 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("make-fixture", "render a sequence with truth.csv from the simulator into DIR")
       .option("landmark", "with --make-fixture: the lab world's landmark id", "L1")
       .option("seed", "with --make-fixture: image noise seed", "1")
-      .option("distances", "with --make-fixture: distances from the landmark [m]", "1.2,1.6,2.0");
+      .option("distances", "with --make-fixture: distances from the landmark [m]", "1.2,1.6,2.0")
+      .option("make-sequences",
+              "write benchmark sequences (a product photo pasted as a poster into real "
+              "backgrounds, truth.csv + sequence.json each) into DIR "
+              "(doc/perception-benchmark.md)")
+      .option("split", "with --make-sequences: dev or heldout (photos and backgrounds)", "dev")
+      .option("present", "with --make-sequences: sequences with the target", "12")
+      .option("absent", "with --make-sequences: target-absent sequences", "4")
+      .option("seq-frames", "with --make-sequences: frames per sequence", "20")
+      .option("classes", "with --make-sequences: comma-separated target classes (default: all)")
+      .option("data",
+              "with --make-sequences: the shared data folder "
+              "(default: $SKETCHNAV_DATA or ../shared/data)")
+      .option("eval",
+              "run every sequence folder (truth.csv + sequence.json) in DIR and report "
+              "the aggregate (eval.json, eval.csv, found_rate.png)");
   if (!args.parse(argv)) return 0;
   if (!args.get("make-fixture").empty()) {
     std::vector<double> ds;
@@ -243,6 +422,8 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     }
     return makeFixture(args.get("make-fixture"), args.get("landmark"), args.getInt("seed"), ds);
   }
+  if (!args.get("make-sequences").empty()) return makeBenchSequences(args, g);
+  if (!args.get("eval").empty()) return runEval(args, g);
   if (args.get("frames").empty()) throw InputError("sketchnav replay: --frames is required");
   if (args.get("target").empty()) throw InputError("sketchnav replay: --target CLASS is required");
   const std::string target = args.get("target");
@@ -250,7 +431,13 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   if (!(hfov > 1 && hfov < 179)) throw InputError("--hfov must be in (1, 179) degrees");
   const long max_frames = args.getInt("max-frames");
   std::map<std::string, std::string> truth;
-  if (!args.get("truth").empty()) truth = readTruth(args.get("truth"));
+  std::optional<bench::SequenceTruth> seq_truth;
+  if (!args.get("truth").empty()) {
+    truth = bench::readTruthCsv(args.get("truth"));
+    // The generator's sidecar next to the CSV gives the true centre, yaw and width per frame.
+    const fs::path side = fs::path(args.get("truth")).parent_path() / "sequence.json";
+    if (fs::is_regular_file(side)) seq_truth = bench::readSequenceJson(side.string());
+  }
 
   auto model = std::make_shared<landmarks::LandmarkModel>(
       landmarks::LandmarkModel::load(ensureModel(args.get("model"), true)));
@@ -277,6 +464,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   std::vector<cv::Mat> thumbs;
   int agree = 0, truth_n = 0, detected = 0, truth_detected = 0, agree_detected = 0;
   std::map<std::string, std::map<std::string, int>> confusion;  // expected -> got -> n
+  std::vector<bench::FrameScore> scores;
   cv::Mat img;
   std::string name;
   hw::Intrinsics k;
@@ -306,10 +494,14 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
       ++detected;
     }
     std::string expected;
+    bool in_truth = true;
     if (auto it = truth.find(name); it != truth.end())
       expected = it->second;
     else if (auto it2 = truth.find(std::to_string(i)); it2 != truth.end())
       expected = it2->second;
+    else
+      in_truth = false;
+    if (in_truth) scores.push_back(score(name, expected, r, x_t, k, seq_truth));
     if (!expected.empty()) {
       ++truth_n;
       agree += expected == r.turn;
@@ -354,6 +546,8 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     // The servo's part alone: agreement on the frames where perception found the landmark.
     result["agreement_when_detected"] =
         truth_detected ? static_cast<double>(agree_detected) / truth_detected : 0.0;
+    // The benchmark's figures (found rate, false reports, bearing error, bins, time).
+    result["benchmark"] = bench::summarise(scores);
   }
   std::ofstream(out + "/replay.json") << result.dump(2) << "\n";
   if (g.json) {
@@ -366,6 +560,16 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
           "where the landmark was found)\n",
           agree, truth_n, truth_n ? 100.0 * agree / truth_n : 0.0, agree_detected, truth_detected,
           truth_detected ? 100.0 * agree_detected / truth_detected : 0.0);
+      const Json b = bench::summarise(scores);
+      std::printf(
+          "target found on %d / %d scored frames; reported on %d / %d target-absent "
+          "frames; bearing error median %s px; %.0f ms per frame (median)\n",
+          b["found"].get<int>(), b["scored_frames"].get<int>(), b["false_reports"].get<int>(),
+          b["absent_frames"].get<int>(),
+          b["bearing_error_px_median"].is_number()
+              ? std::to_string(b["bearing_error_px_median"].get<double>()).c_str()
+              : "-",
+          b["ms_per_frame_median"].get<double>());
       for (const auto& [e, m] : confusion) {
         std::cout << "  expected " << e << ":";
         for (const auto& [gg, cnt] : m) std::cout << " " << gg << " " << cnt;

@@ -1,0 +1,66 @@
+# A small generated slice (3 sequences x 4 frames) through `replay --truth` and `replay --eval`
+# with the demo model: the report counts what the truth files say, bad truth rows fail with a
+# one-line error naming file and line. Skipped (not passed) without the shared data.
+if(DEFINED ENV{SKETCHNAV_DATA} AND NOT "$ENV{SKETCHNAV_DATA}" STREQUAL "")
+  set(DATA $ENV{SKETCHNAV_DATA})
+else()
+  set(DATA ${SRC}/../shared/data)
+endif()
+if(NOT EXISTS ${DATA}/grocery-packages/val OR NOT EXISTS ${DATA}/raccoon/JPEGImages)
+  message("SKIPPED: shared data absent (${DATA})")
+  return()
+endif()
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+include(${CMAKE_CURRENT_LIST_DIR}/../support/expect_exit.cmake)
+# Targets among the demo model's classes (share/landmarks).
+run_ok(out err --json replay --make-sequences ${WORK}/seq --data ${DATA} --split dev --seed 7
+       --present 2 --absent 1 --seq-frames 4
+       --classes Alpro-Blueberry-Soyghurt,Arla-Standard-Milk,Yoggi-Strawberry-Yoghurt)
+string(JSON n LENGTH "${out}" sequences)
+if(NOT n EQUAL 3)
+  message(FATAL_ERROR "expected 3 sequences:\n${out}")
+endif()
+string(JSON first GET "${out}" sequences 0)
+set(SEQ ${WORK}/seq/${first})
+file(READ ${SEQ}/sequence.json side)
+string(JSON target GET "${side}" target)
+file(STRINGS ${SEQ}/truth.csv rows)
+set(scored 0)
+foreach(r ${rows})
+  if(r MATCHES ",[LSR]$")
+    math(EXPR scored "${scored} + 1")
+  endif()
+endforeach()
+run_ok(out err --json replay --frames ${SEQ} --target ${target} --truth ${SEQ}/truth.csv
+       --out ${WORK}/one)
+string(JSON frames GET "${out}" frames)
+string(JSON tf GET "${out}" truth_frames)
+string(JSON bs GET "${out}" benchmark scored_frames)
+string(JSON ms GET "${out}" benchmark ms_per_frame_median)
+if(NOT frames EQUAL 4 OR NOT tf EQUAL ${scored} OR NOT bs EQUAL ${scored} OR NOT ms GREATER 0)
+  message(FATAL_ERROR "replay --truth: frames ${frames}, truth_frames ${tf}, scored ${bs} "
+                      "(truth.csv has ${scored} scored rows), ms ${ms}\n${out}")
+endif()
+run_ok(out err --json replay --eval ${WORK}/seq --out ${WORK}/eval)
+string(JSON frames GET "${out}" frames)
+string(JSON nseq GET "${out}" sequences)
+string(JSON absent GET "${out}" absent_frames)
+string(JSON bins LENGTH "${out}" by_yaw_deg)
+if(NOT frames EQUAL 12 OR NOT nseq EQUAL 3 OR NOT absent EQUAL 4 OR NOT bins EQUAL 4)
+  message(FATAL_ERROR "replay --eval: frames ${frames}, sequences ${nseq}, absent ${absent}\n${out}")
+endif()
+foreach(f eval.json eval.csv found_rate.png)
+  if(NOT EXISTS ${WORK}/eval/${f})
+    message(FATAL_ERROR "replay --eval wrote no ${f}")
+  endif()
+endforeach()
+# Bad truth rows: exit 2, one line naming the file and line.
+file(WRITE ${WORK}/bad.csv "frame,expected\nframe000.jpg,L\nframe001.jpg,Q\n")
+expect(2 "bad.csv:3: expected must be Left, Straight, Right or None" replay --frames ${SEQ}
+       --target ${target} --truth ${WORK}/bad.csv --out ${WORK}/bad)
+file(WRITE ${WORK}/dup.csv "frame000.jpg,L\nframe000.jpg,R\n")
+expect(2 "dup.csv:2: frame 'frame000.jpg' appears twice" replay --frames ${SEQ}
+       --target ${target} --truth ${WORK}/dup.csv --out ${WORK}/bad)
+expect(2 "--split test: must be dev or heldout" replay --make-sequences ${WORK}/x --data ${DATA}
+       --split test)
