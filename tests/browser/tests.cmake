@@ -3,6 +3,7 @@
 # `npm ci` here first).
 sketchnav_add_test(test_ui_http
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ui_http.cpp ${CMAKE_CURRENT_LIST_DIR}/test_ui_run_http.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_ui_hardening.cpp
   LINK sketchnav_webui sketchnav::mapsketch
   LABELS "ui")
 
