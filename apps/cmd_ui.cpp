@@ -13,6 +13,7 @@
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <thread>
@@ -203,11 +204,34 @@ std::vector<std::string> filesEndingIn(const std::string& dir, const std::string
   return out;
 }
 
+// The user's data folder for what the UI writes (sketches, captures): $XDG_DATA_HOME/sketchnav,
+// else ~/.local/share/sketchnav, else runs/ui: never the source tree or the shipped share/.
+std::string userDataDir() {
+  const char* xdg = std::getenv("XDG_DATA_HOME");
+  if (xdg && *xdg && fs::path(xdg).is_absolute()) return (fs::path(xdg) / "sketchnav").string();
+  const char* home = std::getenv("HOME");
+  if (home && *home) return (fs::path(home) / ".local/share/sketchnav").string();
+  return "runs/ui";
+}
+
+// The run page's sketch list, read again on every request: [{path, file, source}].
+Json sketchList(const std::string& examples_dir, const std::string& sketch_dir) {
+  Json out = Json::array();
+  for (const auto& [dir, source] : {std::pair{examples_dir, "example"}, {sketch_dir, "user"}})
+    for (const auto& f : filesEndingIn(dir, ".sketch.json"))
+      out.push_back({{"path", f}, {"file", fs::path(f).filename().string()}, {"source", source}});
+  return out;
+}
+
 int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("ui", "the local web UI: sketch editor, live run view and control", "[options]");
   args.option("landmarks", "landmark set: one folder per class (default: the demo set)")
-      .option("sketch-dir", "directory sketches are opened from and saved to", ".")
-      .option("capture-dir", "where the run page saves captured photos (default: --landmarks)")
+      .option("sketch-dir",
+              "directory sketches are opened from and saved to (default: "
+              "$XDG_DATA_HOME/sketchnav/sketches, i.e. ~/.local/share/sketchnav/sketches)")
+      .option("capture-dir",
+              "where the run page saves captured photos, one folder per class (default: "
+              "$XDG_DATA_HOME/sketchnav/captures; give the --landmarks folder to train on them)")
       .option("model-cache", "landmark model cache directory (default: ~/.cache/sketchnav)")
       .option("host", "address to bind (only loopback is safe)", "127.0.0.1")
       .option("port", "TCP port (0 = any free port)", "8080")
@@ -223,7 +247,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   if (args.has("allow-host")) so.extra_hosts.push_back(args.get("allow-host"));
   ui::EditorOptions eo;
   eo.landmarks_dir = args.has("landmarks") ? args.get("landmarks") : resourcePath("landmarks");
-  eo.sketch_dir = args.get("sketch-dir");
+  eo.sketch_dir = args.has("sketch-dir") ? args.get("sketch-dir") : userDataDir() + "/sketches";
   eo.examples_dir = resourcePath("sketches");
 
   ui::RunApiOptions ro;
@@ -240,7 +264,12 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
       boxes.push_back(w.box);
     return boxes;
   };
-  ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : eo.landmarks_dir;
+  ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : userDataDir() + "/captures";
+  {
+    std::error_code ec;
+    ro.captures_train = fs::exists(ro.capture_dir, ec) &&
+                        fs::equivalent(ro.capture_dir, eo.landmarks_dir, ec) && !ec;
+  }
   ro.worlds = {"lab"};
   for (const auto& f : filesEndingIn(resourcePath("worlds"), ".world.json")) {
     const std::string n = fs::path(f).filename().string();
@@ -248,8 +277,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (std::find(ro.worlds.begin(), ro.worlds.end(), name) == ro.worlds.end())
       ro.worlds.push_back(name);
   }
-  ro.sketches = filesEndingIn(eo.examples_dir, ".sketch.json");
-  for (const auto& f : filesEndingIn(eo.sketch_dir, ".sketch.json")) ro.sketches.push_back(f);
+  ro.list_sketches = [ex = eo.examples_dir, mine = eo.sketch_dir] { return sketchList(ex, mine); };
 
   // Declared before the server so the server (whose routes use it) goes first.
   ui::RunController runs(ro);
@@ -261,10 +289,16 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
     log::warn("ui", "listening beyond this machine: anyone who can reach it can drive the robot",
               {{"host", so.host}});
   if (g.json)
-    printJson({{"url", server.url()}, {"port", server.port()}});
+    printJson({{"url", server.url()},
+               {"port", server.port()},
+               {"sketch_dir", fs::absolute(eo.sketch_dir).string()},
+               {"capture_dir", fs::absolute(ro.capture_dir).string()}});
   else
     std::cout << "sketchnav ui: editor at " << server.url() << ", live run at " << server.url()
-              << "run.html (Ctrl+C to stop)" << std::endl;
+              << "run.html; sketches in " << fs::absolute(eo.sketch_dir).string()
+              << ", captures to " << fs::absolute(ro.capture_dir).string()
+              << (ro.captures_train ? " (the landmark set)" : "") << " (Ctrl+C to stop)"
+              << std::endl;
   g_server = &server;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);

@@ -27,4 +27,11 @@ if(SKETCHNAV_NODE)
       --model-cache ${PROJECT_BINARY_DIR}/model-cache)
   set_tests_properties(browser_run_page PROPERTIES TIMEOUT 300 LABELS "ui;browser"
     SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
+  # The bugs a new user hit (issue 29, Bugs): one check per bug, each failed before its fix.
+  add_test(NAME browser_ui_bugs
+    COMMAND ${SKETCHNAV_NODE} ${_browser_dir}/bugs.test.mjs
+      --sketchnav $<TARGET_FILE:sketchnav>
+      --out ${CMAKE_CURRENT_BINARY_DIR}/browser-bugs)
+  set_tests_properties(browser_ui_bugs PROPERTIES TIMEOUT 180 LABELS "ui;browser"
+    SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
 endif()
