@@ -595,7 +595,9 @@ std::vector<unsigned char> RunController::frameJpeg() const {
     std::snprintf(label, sizeof label, "%s  %d inl", d.class_name.c_str(), d.inliers);
     int base = 0;
     const cv::Size ts = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, fs, 1, &base);
-    const cv::Point org(d.window.x, std::max(ts.height + 4, d.window.y - 4));
+    // Inside the frame: a window at the right edge would cut its label ("19 inl").
+    const cv::Point org(std::max(2, std::min(d.window.x, img.cols - ts.width - 3)),
+                        std::max(ts.height + 4, d.window.y - 4));
     cv::rectangle(img, org + cv::Point(-2, base), org + cv::Point(ts.width + 2, -ts.height - 2), c,
                   cv::FILLED);
     cv::putText(img, label, org, cv::FONT_HERSHEY_SIMPLEX, fs, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);

@@ -185,6 +185,14 @@ function renderLandmarks() {
     t.textContent = `${l.id} · ${l.cls}`;
     const d = el('text', { class: 'dist', x: l.x, y: l.y + l.h + 15 }, gg);
     d.textContent = `${l.distance} m`;
+    // Labels stay inside the canvas: above the box unless that is off the top, below it
+    // unless off the bottom, shifted left when they would run off the right edge.
+    if (l.y - 6 < 14) t.setAttribute('y', Math.min(H - 4, l.y + l.h + 30));
+    if (l.y + l.h + 15 > H - 2) d.setAttribute('y', Math.max(14, l.y - 20));
+    for (const x of [t, d]) {
+      const len = x.getComputedTextLength ? x.getComputedTextLength() : 0;
+      x.setAttribute('x', clamp(l.x, 2, Math.max(2, W - 2 - len)));
+    }
     const order = orderOf(l.id);
     if (order !== null && $('show-route').checked) {
       const b = el('g', { class: 'badge' }, gg);

@@ -141,9 +141,10 @@ const fmt = (v, d = 2) => (typeof v === 'number' ? v.toFixed(d) : '–');
 
 function describeEvent(e) {
   // STOP is the user's choice, not a failure of the run.
-  const parts = [e.type === 'failed' && e.reason === 'stopped by user' ? 'stopped' : e.type];
+  const byUser = e.type === 'failed' && e.reason === 'stopped by user';
+  const parts = [byUser ? 'stopped by user' : e.type];
   if (e.id) parts.push(e.id + (e.class ? ` (${e.class})` : ''));
-  if (e.reason) parts.push(e.reason);
+  if (e.reason && !byUser) parts.push(e.reason);
   if (e.inliers) parts.push(`${e.inliers} inliers`);
   if (e.type === 'section_done') parts.push(`${e.section + 1}/${e.of}`);
   const t = typeof e.t === 'number' ? `${e.t.toFixed(1)}s ` : '';

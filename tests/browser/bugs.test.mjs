@@ -136,7 +136,38 @@ try {
     assert.equal(await pathNow(), drawn);
     await page.click('#tool-select');
   });
+  await check('9: canvas labels stay inside the canvas at its edges', async () => {
+    await page.click('.class-card[data-class="God-Morgon-Red-Grapefruit-Juice"]');
+    await page.click('#add');
+    await page.fill('#dist-input', '3');
+    await page.click('#dist-ok');
+    await page.waitForSelector('.lm[data-id="L2"]');
+    await page.evaluate(() => { const l = state.landmarks.find((x) => x.id === 'L2'); l.x = W - l.w - 4; l.y = 2; render(); });
+    const boxes = await page.$$eval('.lm[data-id="L2"] text', (ts) => ts.map((t) => { const b = t.getBBox(); return [b.x, b.y, b.x + b.width, b.y + b.height]; }));
+    const [w, h] = await page.evaluate(() => [W, H]);
+    for (const b of boxes) assert.ok(b[0] >= 0 && b[1] >= 0 && b[2] <= w && b[3] <= h, `label ${b} inside ${w}x${h}`);
+  });
+
+  await check('9: the active tool button stays readable under the mouse', async () => {
+    await page.hover('#tool-select');
+    const [bg, fg] = await page.$eval('#tool-select', (b) => [getComputedStyle(b).backgroundColor, getComputedStyle(b).color]);
+    const lum = (c) => { const [r, g, b] = c.match(/\d+/g).map(Number); return 0.2126 * r + 0.7152 * g + 0.0722 * b; };
+    assert.ok(Math.abs(lum(bg) - lum(fg)) > 100, `contrast of ${fg} on ${bg}`);
+  });
   await page.screenshot({ path: path.join(out, 'bugs-editor.png') });
+
+  await check('9: on a 390 px phone the editor canvas is usable', async () => {
+    const phone = await browser.newPage({ viewport: { width: 390, height: 844 } });
+    try {
+      await phone.goto(url);
+      await phone.waitForSelector('.class-card');
+      const r = await phone.locator('#canvas').boundingBox();
+      assert.ok(r.width > 300 && r.height > 200, `canvas ${r.width}x${r.height}`);
+      const sw = await phone.evaluate(() => document.documentElement.scrollWidth);
+      assert.ok(sw <= 390, `page ${sw} px wide: no sideways scrolling`);
+      await phone.screenshot({ path: path.join(out, 'bugs-phone.png'), fullPage: true });
+    } finally { await phone.close(); }
+  });
 
   await check('5: a sketch saved in the editor appears on the run page; examples and own files are told apart', async () => {
     await page.fill('#name', 'corridor');  // the same name as the shipped example
@@ -184,6 +215,12 @@ try {
     assert.ok(fs.existsSync(path.join(captures, 'Browser-Mug', 'capture_1.jpg')));
     assert.doesNotMatch(msg, /Retrained on the next run/, msg);
     assert.match(msg, /--landmarks/, msg);
+    const ov = await page.locator('#camera-overlay').boundingBox();
+    await page.mouse.move(ov.x + ov.width * 0.2, ov.y + ov.height * 0.2);
+    await page.mouse.down();
+    await page.mouse.move(ov.x + ov.width * 0.7, ov.y + ov.height * 0.7, { steps: 6 });
+    await page.mouse.up();
+    assert.ok(await page.evaluate(() => box !== null), 'a box is dragged');
     await page.screenshot({ path: path.join(out, 'bugs-capture.png') });
   });
 
@@ -196,7 +233,22 @@ try {
     await page.waitForTimeout(1200);  // six state polls
     assert.match(await page.textContent('#run-message'), /'camera' URI is required/);
     assert.equal(await page.evaluate(() => document.getElementById('camera-img').hasAttribute('src')), false, 'the old frame is not shown after a failed start');
+    assert.equal(await page.evaluate(() => box), null, 'the old capture box is gone');
     await page.screenshot({ path: path.join(out, 'bugs-start-error.png') });
+  });
+
+  await check('9: long values do not wrap the command strip (the camera view does not jump)', async () => {
+    await runPage();
+    // Set and measured in one go (the state poll rewrites these fields).
+    const [h0, h1, cam0, cam1] = await page.evaluate(() => {
+      const strip = $('command-strip'), cam = $('camera-wrap');
+      const h0 = strip.getBoundingClientRect().height, c0 = cam.getBoundingClientRect().height;
+      $('mode').textContent = 'stopped'; $('landmark').textContent = 'God-Morgon-Red-Grapefruit-Juice';
+      $('section').textContent = '10/12'; $('time').textContent = '123.4'; $('w').textContent = '-0.35';
+      return [h0, strip.getBoundingClientRect().height, c0, cam.getBoundingClientRect().height];
+    });
+    assert.equal(h1, h0, 'strip height');
+    assert.equal(cam1, cam0, 'camera view height');
   });
 
   await check('9: the world chosen survives a reload', async () => {
