@@ -13,6 +13,8 @@
 #include <sys/time.h>
 #include <unistd.h>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include <chrono>
 #include <filesystem>
 #include <fstream>
@@ -88,11 +90,20 @@ class UiHardening : public ::testing::Test {
   void SetUp() override {
     dir_ = test::tempDir("uihardening");
     ui::RunApiOptions ro;
-    ro.runner = [](const ui::RunRequest&, const ui::RunHooks& h) -> Json {
+    ro.runner = [](const ui::RunRequest& rq, const ui::RunHooks& h) -> Json {
       auto camera = h.wrap_camera(std::make_unique<OneColourCamera>());
       for (int i = 0; i < 3000 && !h.stop_requested(); ++i) {
         hw::Frame f;
         camera->grab(f, 1.0);
+        if (rq.world == "edge") {  // a detection at the frame's right edge
+          nav::Observation o;
+          nav::Detection d;
+          d.class_name = "God-Morgon-Red-Grapefruit-Juice";
+          d.window = {130, 40, 30, 40};
+          d.inliers = 19;
+          o.detections.push_back(d);
+          h.on_observation(f, o);
+        }
         std::this_thread::sleep_for(std::chrono::milliseconds(10));
       }
       return {{"success", false}, {"reason", "stopped by user"}};
@@ -210,6 +221,34 @@ TEST_F(UiHardening, AHugeCaptureNumberInTheFolderIsNotAnError) {
   EXPECT_EQ(r->status, 200) << r->body;
   EXPECT_TRUE(fs::exists(dir_ + "/captures/Mug/capture_8.jpg"));
   cli_->Post("/api/run/stop", "{}", "application/json");
+}
+
+TEST_F(UiHardening, DetectionLabelsStayInsideTheFrame) {
+  auto r = cli_->Post("/api/run/start", Json{{"world", "edge"}}.dump(), "application/json");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(r->status, 200) << r->body;
+  cv::Mat img;
+  for (int i = 0; i < 300 && img.empty(); ++i) {
+    auto f = cli_->Get("/api/run/frame.jpg");
+    if (f && f->status == 200 &&
+        Json::parse(cli_->Get("/api/run/state")->body)["shown_seq"] ==
+            Json::parse(cli_->Get("/api/run/state")->body)["perception"]["frame_seq"])
+      img = cv::imdecode(std::vector<unsigned char>(f->body.begin(), f->body.end()),
+                         cv::IMREAD_COLOR);
+    std::this_thread::sleep_for(std::chrono::milliseconds(10));
+  }
+  cli_->Post("/api/run/stop", "{}", "application/json");
+  ASSERT_FALSE(img.empty());
+  // The label's green background, in the rows above the window: it must start far enough
+  // left of the window (x = 130 of 160) for the whole text to fit in the frame.
+  int leftmost = img.cols;
+  for (int y = 0; y < 36; ++y)
+    for (int x = 0; x < img.cols; ++x) {
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, x);
+      if (std::abs(p[0] - 40) < 45 && std::abs(p[1] - 200) < 50 && std::abs(p[2] - 40) < 45)
+        leftmost = std::min(leftmost, x);
+    }
+  EXPECT_LT(leftmost, 60) << "the label starts at x = " << leftmost << " of " << img.cols;
 }
 
 TEST_F(UiHardening, StopIsServedWhileManyIdleConnectionsAreHeld) {
