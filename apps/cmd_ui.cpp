@@ -10,6 +10,7 @@
 #include "run_api.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -31,10 +32,12 @@ namespace sketchnav::app {
 namespace {
 namespace fs = std::filesystem;
 
-ui::Server* g_server = nullptr;
+// Ctrl+C / SIGTERM only set a flag (async-signal-safe); a watcher thread then stops the run
+// (the base first) before it stops the server, so a robot never waits for the server's
+// connections (slow or idle clients hold their threads up to the read timeout) to close.
+std::atomic<bool> g_signalled{false};
 extern "C" void onSignal(int) {
-  // httplib's stop() only flips a flag and shuts the listening socket: safe enough here.
-  if (g_server) g_server->stop();
+  g_signalled = true;
 }
 
 bool endsWith(const std::string& s, const std::string& suffix) {
@@ -299,11 +302,32 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
               << ", captures to " << fs::absolute(ro.capture_dir).string()
               << (ro.captures_train ? " (the landmark set)" : "") << " (Ctrl+C to stop)"
               << std::endl;
-  g_server = &server;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  std::atomic<bool> served{false};
+  std::thread watcher([&] {
+    while (!served) {
+      if (g_signalled) {
+        runs.stop();  // the base stops now, whatever the server is still waiting for
+        server.stop();
+        // A client dribbling bytes keeps its connection (and the server's shutdown) going
+        // for as long as it likes: after 3 s, end the run and exit without it.
+        for (int i = 0; i < 150 && !served; ++i)
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (!served) {
+          log::warn("ui", "connections still open 3 s after the stop signal: exiting anyway", {});
+          runs.join();
+          std::cout.flush();
+          std::_Exit(0);
+        }
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
   server.serve();
-  g_server = nullptr;
+  served = true;
+  watcher.join();
   return 0;  // ~RunController stops a run still going (the base first) and waits for it
 }
 const CommandRegistration reg("ui", "the local web UI: sketch editor, live run view and control",
