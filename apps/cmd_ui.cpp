@@ -10,9 +10,11 @@
 #include "run_api.h"
 
 #include <algorithm>
+#include <atomic>
 #include <chrono>
 #include <cmath>
 #include <csignal>
+#include <cstdlib>
 #include <filesystem>
 #include <iostream>
 #include <thread>
@@ -30,10 +32,12 @@ namespace sketchnav::app {
 namespace {
 namespace fs = std::filesystem;
 
-ui::Server* g_server = nullptr;
+// Ctrl+C / SIGTERM only set a flag (async-signal-safe); a watcher thread then stops the run
+// (the base first) before it stops the server, so a robot never waits for the server's
+// connections (slow or idle clients hold their threads up to the read timeout) to close.
+std::atomic<bool> g_signalled{false};
 extern "C" void onSignal(int) {
-  // httplib's stop() only flips a flag and shuts the listening socket: safe enough here.
-  if (g_server) g_server->stop();
+  g_signalled = true;
 }
 
 bool endsWith(const std::string& s, const std::string& suffix) {
@@ -203,11 +207,34 @@ std::vector<std::string> filesEndingIn(const std::string& dir, const std::string
   return out;
 }
 
+// The user's data folder for what the UI writes (sketches, captures): $XDG_DATA_HOME/sketchnav,
+// else ~/.local/share/sketchnav, else runs/ui: never the source tree or the shipped share/.
+std::string userDataDir() {
+  const char* xdg = std::getenv("XDG_DATA_HOME");
+  if (xdg && *xdg && fs::path(xdg).is_absolute()) return (fs::path(xdg) / "sketchnav").string();
+  const char* home = std::getenv("HOME");
+  if (home && *home) return (fs::path(home) / ".local/share/sketchnav").string();
+  return "runs/ui";
+}
+
+// The run page's sketch list, read again on every request: [{path, file, source}].
+Json sketchList(const std::string& examples_dir, const std::string& sketch_dir) {
+  Json out = Json::array();
+  for (const auto& [dir, source] : {std::pair{examples_dir, "example"}, {sketch_dir, "user"}})
+    for (const auto& f : filesEndingIn(dir, ".sketch.json"))
+      out.push_back({{"path", f}, {"file", fs::path(f).filename().string()}, {"source", source}});
+  return out;
+}
+
 int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("ui", "the local web UI: sketch editor, live run view and control", "[options]");
   args.option("landmarks", "landmark set: one folder per class (default: the demo set)")
-      .option("sketch-dir", "directory sketches are opened from and saved to", ".")
-      .option("capture-dir", "where the run page saves captured photos (default: --landmarks)")
+      .option("sketch-dir",
+              "directory sketches are opened from and saved to (default: "
+              "$XDG_DATA_HOME/sketchnav/sketches, i.e. ~/.local/share/sketchnav/sketches)")
+      .option("capture-dir",
+              "where the run page saves captured photos, one folder per class (default: "
+              "$XDG_DATA_HOME/sketchnav/captures; give the --landmarks folder to train on them)")
       .option("model-cache", "landmark model cache directory (default: ~/.cache/sketchnav)")
       .option("host", "address to bind (only loopback is safe)", "127.0.0.1")
       .option("port", "TCP port (0 = any free port)", "8080")
@@ -223,7 +250,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   if (args.has("allow-host")) so.extra_hosts.push_back(args.get("allow-host"));
   ui::EditorOptions eo;
   eo.landmarks_dir = args.has("landmarks") ? args.get("landmarks") : resourcePath("landmarks");
-  eo.sketch_dir = args.get("sketch-dir");
+  eo.sketch_dir = args.has("sketch-dir") ? args.get("sketch-dir") : userDataDir() + "/sketches";
   eo.examples_dir = resourcePath("sketches");
 
   ui::RunApiOptions ro;
@@ -240,7 +267,12 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
       boxes.push_back(w.box);
     return boxes;
   };
-  ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : eo.landmarks_dir;
+  ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : userDataDir() + "/captures";
+  {
+    std::error_code ec;
+    ro.captures_train = fs::exists(ro.capture_dir, ec) &&
+                        fs::equivalent(ro.capture_dir, eo.landmarks_dir, ec) && !ec;
+  }
   ro.worlds = {"lab"};
   for (const auto& f : filesEndingIn(resourcePath("worlds"), ".world.json")) {
     const std::string n = fs::path(f).filename().string();
@@ -248,8 +280,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (std::find(ro.worlds.begin(), ro.worlds.end(), name) == ro.worlds.end())
       ro.worlds.push_back(name);
   }
-  ro.sketches = filesEndingIn(eo.examples_dir, ".sketch.json");
-  for (const auto& f : filesEndingIn(eo.sketch_dir, ".sketch.json")) ro.sketches.push_back(f);
+  ro.list_sketches = [ex = eo.examples_dir, mine = eo.sketch_dir] { return sketchList(ex, mine); };
 
   // Declared before the server so the server (whose routes use it) goes first.
   ui::RunController runs(ro);
@@ -261,15 +292,42 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
     log::warn("ui", "listening beyond this machine: anyone who can reach it can drive the robot",
               {{"host", so.host}});
   if (g.json)
-    printJson({{"url", server.url()}, {"port", server.port()}});
+    printJson({{"url", server.url()},
+               {"port", server.port()},
+               {"sketch_dir", fs::absolute(eo.sketch_dir).string()},
+               {"capture_dir", fs::absolute(ro.capture_dir).string()}});
   else
     std::cout << "sketchnav ui: editor at " << server.url() << ", live run at " << server.url()
-              << "run.html (Ctrl+C to stop)" << std::endl;
-  g_server = &server;
+              << "run.html; sketches in " << fs::absolute(eo.sketch_dir).string()
+              << ", captures to " << fs::absolute(ro.capture_dir).string()
+              << (ro.captures_train ? " (the landmark set)" : "") << " (Ctrl+C to stop)"
+              << std::endl;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
+  std::atomic<bool> served{false};
+  std::thread watcher([&] {
+    while (!served) {
+      if (g_signalled) {
+        runs.stop();  // the base stops now, whatever the server is still waiting for
+        server.stop();
+        // A client dribbling bytes keeps its connection (and the server's shutdown) going
+        // for as long as it likes: after 3 s, end the run and exit without it.
+        for (int i = 0; i < 150 && !served; ++i)
+          std::this_thread::sleep_for(std::chrono::milliseconds(20));
+        if (!served) {
+          log::warn("ui", "connections still open 3 s after the stop signal: exiting anyway", {});
+          runs.join();
+          std::cout.flush();
+          std::_Exit(0);
+        }
+        return;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
   server.serve();
-  g_server = nullptr;
+  served = true;
+  watcher.join();
   return 0;  // ~RunController stops a run still going (the base first) and waits for it
 }
 const CommandRegistration reg("ui", "the local web UI: sketch editor, live run view and control",

@@ -95,6 +95,12 @@ mapsketch::Sketch parseBody(const httplib::Request& req, const std::string& orig
                             const std::vector<std::string>& classes) {
   if (req.body.empty())
     throw InputError(origin + ": empty request body (expected a sketch as JSON)");
+  const std::size_t bad = invalidUtf8At(req.body);
+  if (bad != std::string::npos) {
+    const std::string field = jsonFieldAt(req.body, bad);
+    throw InputError(origin + ": " + (field.empty() ? "the sketch" : "'" + field + "'") +
+                     " is not valid UTF-8 (byte " + std::to_string(bad) + ")");
+  }
   mapsketch::Sketch s = mapsketch::sketchFromText(req.body, origin);
   mapsketch::validateClasses(s, classes, origin);
   return s;

@@ -66,10 +66,24 @@ RunRequest RunRequest::fromJson(const Json& j) {
       throw InputError("run request: 'camera_only' must be true or false");
     r.camera_only = j["camera_only"].get<bool>();
   }
-  if (r.camera_only) {
+  std::string mode;
+  str("mode", mode);
+  if (!mode.empty() && mode != "sim" && mode != "hardware" && mode != "camera")
+    throw InputError("run request: 'mode' must be \"sim\", \"hardware\" or \"camera\"");
+  if (r.camera_only || mode == "camera") {
     if (r.camera.empty()) throw InputError("run request: 'camera' URI is required for camera only");
+    r.camera_only = true;
     return r;
   }
+  // Any device field present (even empty) asks for the real robot: never fall back to a
+  // simulated run because the fields were left blank.
+  bool asks_robot = mode == "hardware";
+  for (const char* k : {"robot", "camera", "laser", "sonar"})
+    if (j.contains(k) && !j[k].is_null()) asks_robot = true;
+  if (mode == "sim" && r.hardware())
+    throw InputError("run request: device URIs given for a simulated run ('mode': \"sim\")");
+  if (asks_robot && r.robot.empty())
+    throw InputError("run request: 'robot' URI is required for a run on the robot");
   if (!r.hardware() && r.world.empty())
     throw InputError("run request: 'world' is required for a simulated run");
   if (r.hardware() && r.robot.empty())
@@ -581,7 +595,9 @@ std::vector<unsigned char> RunController::frameJpeg() const {
     std::snprintf(label, sizeof label, "%s  %d inl", d.class_name.c_str(), d.inliers);
     int base = 0;
     const cv::Size ts = cv::getTextSize(label, cv::FONT_HERSHEY_SIMPLEX, fs, 1, &base);
-    const cv::Point org(d.window.x, std::max(ts.height + 4, d.window.y - 4));
+    // Inside the frame: a window at the right edge would cut its label ("19 inl").
+    const cv::Point org(std::max(2, std::min(d.window.x, img.cols - ts.width - 3)),
+                        std::max(ts.height + 4, d.window.y - 4));
     cv::rectangle(img, org + cv::Point(-2, base), org + cv::Point(ts.width + 2, -ts.height - 2), c,
                   cv::FILLED);
     cv::putText(img, label, org, cv::FONT_HERSHEY_SIMPLEX, fs, cv::Scalar(0, 0, 0), 1, cv::LINE_AA);
@@ -609,10 +625,12 @@ Json RunController::capture(const std::string& class_name, const std::optional<c
     img = img(r).clone();
   }
   const fs::path dir = fs::path(opt_.capture_dir) / cls;
+  const bool new_class = !fs::is_directory(dir) || fs::is_empty(dir);
   fs::create_directories(dir);
   // Next free number: never overwrite an earlier capture.
   int n = 1;
-  static const std::regex num(R"(capture_(\d+)\.jpg)");
+  // Numbers of up to 9 digits count; a longer one (a file named by someone else) is ignored.
+  static const std::regex num(R"(capture_(\d{1,9})\.jpg)");
   for (const auto& e : fs::directory_iterator(dir)) {
     std::smatch m;
     const std::string name = e.path().filename().string();
@@ -626,18 +644,17 @@ Json RunController::capture(const std::string& class_name, const std::optional<c
           {"class", cls},
           {"width", img.cols},
           {"height", img.rows},
-          {"new_class", n == 1}};
+          {"new_class", new_class},
+          // Whether the next run trains on it: only when captures go into the landmark set.
+          {"trains_next_run", opt_.captures_train},
+          {"capture_dir", opt_.capture_dir}};
 }
 
 // ---- routes --------------------------------------------------------------------------------
 
 void addRunRoutes(Server& server, RunController& rc) {
-  auto parse = [](const httplib::Request& req) {
-    if (req.body.empty()) return Json::object();
-    return Json::parse(req.body);
-  };
-  server.post("/api/run/start", [&rc, parse](const httplib::Request& req, httplib::Response& res) {
-    const RunRequest r = RunRequest::fromJson(parse(req));
+  server.post("/api/run/start", [&rc](const httplib::Request& req, httplib::Response& res) {
+    const RunRequest r = RunRequest::fromJson(parseJsonBody(req, "run request"));
     rc.start(r);
     sendJson(res, rc.state());
   });
@@ -657,10 +674,17 @@ void addRunRoutes(Server& server, RunController& rc) {
     res.set_content(std::string(jpg.begin(), jpg.end()), "image/jpeg");
   });
   server.get("/api/run/worlds", [&rc](const httplib::Request&, httplib::Response& res) {
-    sendJson(res, {{"worlds", rc.options().worlds}, {"sketches", rc.options().sketches}});
+    const auto& o = rc.options();
+    // Listed on every request: a sketch saved in the editor appears without a restart.
+    Json list = Json::array();
+    for (const auto& s : o.sketches) list.push_back(s);
+    Json detailed = o.list_sketches ? o.list_sketches() : Json::array();
+    for (const auto& s : detailed)
+      if (s.contains("path")) list.push_back(s["path"]);
+    sendJson(res, {{"worlds", o.worlds}, {"sketches", list}, {"sketch_files", detailed}});
   });
-  server.post("/api/capture", [&rc, parse](const httplib::Request& req, httplib::Response& res) {
-    const Json j = parse(req);
+  server.post("/api/capture", [&rc](const httplib::Request& req, httplib::Response& res) {
+    const Json j = parseJsonBody(req, "capture");
     if (!j.contains("class") || !j["class"].is_string())
       throw InputError("capture: 'class' (a landmark class name) is required");
     std::optional<cv::Rect> box;

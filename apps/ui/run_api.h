@@ -8,8 +8,8 @@
 // handed RunHooks and reports through them. That keeps this library free of the simulator
 // and the vision stack, and lets the HTTP tests drive the page's API with a scripted runner.
 //
-//   POST /api/run/start   {world, sketch, robot, camera, laser, sonar, seed, max_time_s,
-//                          camera_only}
+//   POST /api/run/start   {mode: sim|hardware|camera, world, sketch, robot, camera, laser,
+//                          sonar, seed, max_time_s, camera_only}
 //   POST /api/run/stop    stops the base at once, then ends the run ("stopped by user")
 //   GET  /api/run/state   status, section k/n, mode, turn, v, w, pose, landmarks, health...
 //   GET  /api/run/frame.jpg  latest camera frame, detections drawn (404 before the first)
@@ -78,7 +78,13 @@ struct RunApiOptions {
   Runner runner;
   std::string capture_dir;            // where captures go: one folder per class (the landmark set)
   std::vector<std::string> worlds;    // offered on the page (names)
-  std::vector<std::string> sketches;  // offered on the page (paths or names)
+  std::vector<std::string> sketches;  // offered on the page (paths or names), fixed
+  /// Sketches offered on the page, listed again on every request (so sketches saved in the
+  /// editor appear): [{path, file, source: "example" | "user"}]. Optional.
+  std::function<Json()> list_sketches;
+  /// True when capture_dir is the landmark set the runs train on (the next run retrains
+  /// with the captures); false when captures only collect photos for later.
+  bool captures_train = false;
   /// The objectness windows perception examined in a frame, drawn on the live view; computed
   /// on demand (only while someone watches), optional.
   std::function<std::vector<cv::Rect>(const cv::Mat&)> propose_windows;

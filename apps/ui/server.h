@@ -23,6 +23,11 @@ struct ServerOptions {
   std::string web_root;                   // static files; "" = none
   std::size_t max_body_bytes = 5u << 20;  // larger request bodies get 413
   std::vector<std::string> extra_hosts;   // more Host names to accept (e.g. "robot.local")
+  // Connections: each is served on its own thread (so idle or slow clients cannot hold up
+  // STOP behind them), at most max_connections at once; more wait for a free slot.
+  std::size_t max_connections = 1024;
+  int read_timeout_s = 5;        // a request's headers or body stalled this long [s]: closed
+  int keep_alive_timeout_s = 5;  // an idle kept-alive connection is closed after this [s]
 };
 
 using Handler = std::function<void(const httplib::Request&, httplib::Response&)>;
@@ -57,12 +62,22 @@ class Server {
 
  private:
   Handler wrap(Handler h) const;
+  httplib::Server::HandlerResponse guard(const httplib::Request& req, httplib::Response& res) const;
   ServerOptions opt_;
   std::unique_ptr<httplib::Server> http_;
   int port_ = 0;
 };
 
-/// Response helpers for handlers.
+/// The request body as JSON; InputError naming the field (or byte) when it is not UTF-8 or
+/// not JSON. `what` names the request in the message ("run request"). "" -> {}.
+Json parseJsonBody(const httplib::Request& req, const std::string& what);
+/// Byte offset of the first byte of `s` that is not well-formed UTF-8, or npos.
+std::size_t invalidUtf8At(const std::string& s);
+/// "in 'key'" for the JSON object key whose value holds byte `offset` of `text` (a guess from
+/// the text before it), or "" when none is found.
+std::string jsonFieldAt(const std::string& text, std::size_t offset);
+
+/// Response helpers for handlers (messages that are not UTF-8 are sent with U+FFFD).
 void sendJson(httplib::Response& res, const Json& j, int status = 200);
 void sendError(httplib::Response& res, int status, const std::string& message);
 

@@ -24,6 +24,7 @@ let routeError = '';
 let drag = null;           // current pointer interaction
 let dirty = false;         // edits since the last save / open
 let savedFiles = [];       // sketches in the sketch directory (to ask before overwriting)
+let lastDown = null;       // the last press on a landmark {id, t, p}: two quick ones = double-click
 
 // ---------- helpers ----------
 function el(tag, attrs = {}, parent = null) {
@@ -184,6 +185,14 @@ function renderLandmarks() {
     t.textContent = `${l.id} · ${l.cls}`;
     const d = el('text', { class: 'dist', x: l.x, y: l.y + l.h + 15 }, gg);
     d.textContent = `${l.distance} m`;
+    // Labels stay inside the canvas: above the box unless that is off the top, below it
+    // unless off the bottom, shifted left when they would run off the right edge.
+    if (l.y - 6 < 14) t.setAttribute('y', Math.min(H - 4, l.y + l.h + 30));
+    if (l.y + l.h + 15 > H - 2) d.setAttribute('y', Math.max(14, l.y - 20));
+    for (const x of [t, d]) {
+      const len = x.getComputedTextLength ? x.getComputedTextLength() : 0;
+      x.setAttribute('x', clamp(l.x, 2, Math.max(2, W - 2 - len)));
+    }
     const order = orderOf(l.id);
     if (order !== null && $('show-route').checked) {
       const b = el('g', { class: 'badge' }, gg);
@@ -379,6 +388,17 @@ function onPointerDown(evt) {
   if (tool === 'select') {
     if (lmNode) {
       const l = state.landmarks.find((x) => x.id === lmNode.dataset.id);
+      // Double-click, detected here: each press redraws the landmark, so the browser's own
+      // dblclick never arrives (the two clicks land on different elements).
+      const now = performance.now();
+      if (lastDown && lastDown.id === l.id && now - lastDown.t < 500 &&
+          Math.hypot(lastDown.p[0] - p[0], lastDown.p[1] - p[1]) < 8) {
+        lastDown = null;
+        drag = null;
+        editDistance(l.id);
+        return;
+      }
+      lastDown = { id: l.id, t: now, p };
       selectedId = l.id;
       drag = { kind: target.dataset.handle ? 'resize' : 'move', l, from: p, orig: { ...l }, saved: snapshot(), moved: false };
     } else {
@@ -388,9 +408,11 @@ function onPointerDown(evt) {
   } else if (tool === 'path') {
     const saved = snapshot();
     const end = state.path[state.path.length - 1];
-    // Pressing near the end of the existing path continues it; elsewhere starts a new one.
+    // Pressing near the end of the existing path continues it; elsewhere starts a new one,
+    // which replaces the old path only when the user says so (on release).
+    const replacing = !(end && Math.hypot(end[0] - p[0], end[1] - p[1]) < 25) && state.path.length > 1;
     if (!(end && Math.hypot(end[0] - p[0], end[1] - p[1]) < 25)) state.path = [p];
-    drag = { kind: 'path', saved };
+    drag = { kind: 'path', saved, replacing };
   } else if (tool === 'start' || tool === 'goal') {
     pushHistory();
     state[tool] = p;
@@ -433,6 +455,13 @@ function onPointerUp() {
   drag = null;
   if (d.kind === 'path') {
     if (state.path.length < 2) { state.path = JSON.parse(d.saved).path; setStatus('Press and drag to draw the path.'); render(); return; }
+    if (d.replacing && !confirm('Replace the whole guide path with this stroke?\n(To continue the path, press near its end; Cancel keeps the old path.)')) {
+      const old = JSON.parse(d.saved);
+      Object.assign(state, { path: old.path, start: old.start, goal: old.goal });
+      setStatus('Stroke discarded: the path is unchanged. Press near its end to continue it.');
+      render();
+      return;
+    }
     history.push(d.saved); $('undo').disabled = false;
     setStatus(`Path: ${state.path.length} points.`);
     changed();
@@ -559,10 +588,7 @@ function init() {
   svg.addEventListener('pointermove', onPointerMove);
   svg.addEventListener('pointerup', onPointerUp);
   svg.addEventListener('pointercancel', onPointerUp);
-  svg.addEventListener('dblclick', (e) => {
-    const n = e.target.closest && e.target.closest('.lm');
-    if (n && tool === 'select') editDistance(n.dataset.id);
-  });
+  $('dist-cancel').addEventListener('click', () => $('dist-dialog').close('cancel'));
   document.querySelectorAll('.tool').forEach((b) => b.addEventListener('click', () => setTool(b.dataset.tool)));
   $('add').addEventListener('click', addLandmark);
   $('undo').addEventListener('click', undo);

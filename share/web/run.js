@@ -31,35 +31,83 @@ document.querySelectorAll('input[name=mode]').forEach((r) => r.addEventListener(
   $('hw-fields').hidden = mode() !== 'hardware';
 }));
 
+// The sketches offered, listed again whenever the list is opened: a sketch saved in the
+// editor appears without a restart. Shipped examples and the user's own files are kept apart
+// (a user's file may have an example's name).
+function fillSketches(w) {
+  const sel = $('sketch'), keep = sel.value;
+  sel.replaceChildren(new Option("the world's own sketch", ''));
+  const files = w.sketch_files || w.sketches.map((p) => ({ path: p, file: p.replace(/^.*\//, ''), source: '' }));
+  const groups = [['example', 'Shipped examples', ' (example)'], ['user', 'Your sketches', ' (yours)'], ['', 'Sketches', '']];
+  for (const [source, label, suffix] of groups) {
+    const list = files.filter((f) => (f.source || '') === source);
+    if (!list.length) continue;
+    const g = document.createElement('optgroup');
+    g.label = label;
+    for (const f of list) {
+      const o = new Option(f.file.replace(/\.sketch\.json$/, '') + suffix, f.path);
+      o.title = f.path;
+      o.dataset.source = source;
+      g.append(o);
+    }
+    sel.append(g);
+  }
+  sel.value = [...sel.options].some((o) => o.value === keep) ? keep : '';
+}
+async function refreshSketches() {
+  try { fillSketches(await api('GET', '/api/run/worlds')); } catch (_) { /* kept as it was */ }
+}
+$('sketch').addEventListener('focus', refreshSketches);
+$('sketch').addEventListener('pointerdown', refreshSketches);
+
 async function loadChoices() {
   try {
     const w = await api('GET', '/api/run/worlds');
     for (const name of w.worlds) $('world').append(new Option(name, name));
-    for (const s of w.sketches) $('sketch').append(new Option(s.replace(/^.*\//, ''), s));
-    if (w.worlds.includes('corridor')) $('world').value = 'corridor';
+    fillSketches(w);
+    // The last world chosen on this machine survives a reload.
+    const last = localStorage.getItem('sketchnav.run.world');
+    if (last && w.worlds.includes(last)) $('world').value = last;
+    else if (w.worlds.includes('corridor')) $('world').value = 'corridor';
   } catch (e) { message($('run-message'), 'Cannot list worlds: ' + e.message, 'error'); }
   try {
-    const classes = await api('GET', '/api/classes');
-    for (const c of classes) $('class-list').append(new Option(c.name));
-  } catch (_) { /* the class list is only a convenience */ }
+    const r = await api('GET', '/api/classes');
+    for (const c of r.classes) $('class-list').append(new Option(c.name));
+  } catch (e) {
+    message($('capture-message'), 'No class-name suggestions: ' + e.message, 'error');
+  }
 }
+$('world').addEventListener('change', () => localStorage.setItem('sketchnav.run.world', $('world').value));
 
 // ---- start / stop ---------------------------------------------------------------------
+// A refused start stays on the page until the next start: the state poll shows the previous
+// run's end otherwise, which would replace the error at once.
+let startError = null;
+function clearCamera() {
+  box = null;
+  drawBox();
+  $('camera-img').removeAttribute('src');
+  $('camera-none').hidden = false;
+  frameSize = [0, 0];
+}
 async function start(req, what) {
   $('start').disabled = true;
+  clearCamera();  // neither the old frame nor the old capture box belong to this run
   try {
     await api('POST', '/api/run/start', req);
+    startError = null;
     message($('run-message'), what);
   } catch (e) {
-    message($('run-message'), e.message, 'error');
+    startError = e.message;
+    message($('run-message'), 'Not started: ' + e.message, 'error');
   }
   poll(true);
 }
 $('camera-only').addEventListener('click', () => {
-  start({ camera_only: true, camera: $('camera').value.trim() }, 'Opening the camera…');
+  start({ mode: 'camera', camera_only: true, camera: $('camera').value.trim() }, 'Opening the camera…');
 });
 $('start').addEventListener('click', async () => {
-  const req = { max_time_s: Number($('max-time').value) || 0 };
+  const req = { mode: mode(), max_time_s: Number($('max-time').value) || 0 };
   if (mode() === 'sim') {
     req.world = $('world').value;
     req.sketch = $('sketch').value;
@@ -92,9 +140,11 @@ let frameLoading = false;
 const fmt = (v, d = 2) => (typeof v === 'number' ? v.toFixed(d) : '–');
 
 function describeEvent(e) {
-  const parts = [e.type];
+  // STOP is the user's choice, not a failure of the run.
+  const byUser = e.type === 'failed' && e.reason === 'stopped by user';
+  const parts = [byUser ? 'stopped by user' : e.type];
   if (e.id) parts.push(e.id + (e.class ? ` (${e.class})` : ''));
-  if (e.reason) parts.push(e.reason);
+  if (e.reason && !byUser) parts.push(e.reason);
   if (e.inliers) parts.push(`${e.inliers} inliers`);
   if (e.type === 'section_done') parts.push(`${e.section + 1}/${e.of}`);
   const t = typeof e.t === 'number' ? `${e.t.toFixed(1)}s ` : '';
@@ -111,8 +161,11 @@ function render(s) {
   $('stop').disabled = !s.active;
   $('capture-frame').disabled = !(s.frame_seq > 0);
   $('capture-box').disabled = !(s.frame_seq > 0 && box);
-  if (!s.active && s.status !== 'idle') {
-    const txt = s.status === 'error' ? 'Run failed to start: ' + s.reason : `Run ${s.status}: ${s.reason}`;
+  if (s.active) startError = null;  // a run is going after all (started elsewhere)
+  if (startError) {
+    // keep the refusal visible
+  } else if (!s.active && s.status !== 'idle') {
+    const txt = s.status === 'error' ? 'Run failed: ' + s.reason : `Run ${s.status}: ${s.reason}`;
     message($('run-message'), txt, s.status === 'succeeded' ? 'ok' : s.status === 'stopped' ? '' : 'error');
   } else if (s.status === 'running') {
     message($('run-message'), 'Running.');
@@ -161,12 +214,13 @@ function render(s) {
   $('events').replaceChildren(...s.events.slice().reverse().map((e) => {
     const li = document.createElement('li');
     li.textContent = describeEvent(e);
-    if (e.type === 'failed' || e.type === 'fault') li.className = 'fail';
+    const byUser = e.reason === 'stopped by user';
+    if ((e.type === 'failed' && !byUser) || e.type === 'fault') li.className = 'fail';
     return li;
   }));
 
   // A new frame: fetch it unless the previous one is still loading.
-  if (s.shown_seq > 0 && s.shown_seq !== frameSeq && !frameLoading && !dragFrom) {
+  if (s.shown_seq > 0 && s.shown_seq !== frameSeq && !frameLoading && !dragFrom && !startError) {
     frameLoading = true;
     frameSeq = s.shown_seq;
     $('camera-img').src = `/api/run/frame.jpg?seq=${s.shown_seq}`;
@@ -321,8 +375,13 @@ async function capture(withBox) {
   if (!cls) { message($('capture-message'), 'Type a class name first.', 'error'); $('capture-class').focus(); return; }
   try {
     const r = await api('POST', '/api/capture', withBox ? { class: cls, box } : { class: cls });
-    message($('capture-message'), `Saved ${r.file.replace(/^.*\/([^/]+\/[^/]+)$/, '$1')} (${r.width}×${r.height})${r.new_class ? ' — new class' : ''}. Retrained on the next run.`, 'ok');
-    if (r.new_class) $('class-list').append(new Option(r.class));
+    const saved = `Saved ${r.file.replace(/^.*\/([^/]+\/[^/]+)$/, '$1')} (${r.width}×${r.height})`;
+    // Only captures into the landmark set the runs use are trained on.
+    const what = r.trains_next_run
+      ? (r.new_class ? ' — a new class; the next run retrains the model with it.' : '; the next run retrains the model with it.')
+      : ` into ${r.capture_dir}${r.new_class ? ' (a new class folder)' : ''}. Runs use another landmark set: start \`sketchnav ui --landmarks ${r.capture_dir}\` to train on these photos.`;
+    message($('capture-message'), saved + what, 'ok');
+    if (![...$('class-list').options].some((o) => o.value === r.class)) $('class-list').append(new Option(r.class));
   } catch (e) {
     message($('capture-message'), e.message, 'error');
   }

@@ -144,6 +144,13 @@ try {
   assert.ok(s2.events.some((e) => e.reason === 'stopped by user'), 'event: ' + JSON.stringify(s2.events.slice(-3)));
   assert.equal(s2.summary.executive.reason, 'stopped by user');
   assert.match(await page.textContent('#run-message'), /stopped/);
+  // STOP is the user's choice: logged as "stopped by user", not in red as a failure (issue 29, 9).
+  await page.waitForFunction(() => [...document.querySelectorAll('#events li')].some((li) => /stopped by user/.test(li.textContent)));
+  const stopItems = await page.$$eval('#events li', (ls) => ls.filter((li) => /stopped by user/.test(li.textContent)).map((li) => [li.textContent, li.className]));
+  for (const [text, cls] of stopItems) {
+    assert.doesNotMatch(text, /failed/, text);
+    assert.notEqual(cls, 'fail', `"${text}" is not shown as a failure`);
+  }
   assert.ok(await page.isDisabled('#stop'), 'STOP disabled after the run');
   assert.ok(!(await page.isDisabled('#start')), 'Start enabled again');
   assert.deepEqual(pageErrors, [], 'no errors on the page');

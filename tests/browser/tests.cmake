@@ -3,6 +3,7 @@
 # `npm ci` here first).
 sketchnav_add_test(test_ui_http
   SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_ui_http.cpp ${CMAKE_CURRENT_LIST_DIR}/test_ui_run_http.cpp
+    ${CMAKE_CURRENT_LIST_DIR}/test_ui_hardening.cpp
   LINK sketchnav_webui sketchnav::mapsketch
   LABELS "ui")
 
@@ -25,5 +26,12 @@ if(SKETCHNAV_NODE)
       --out ${CMAKE_CURRENT_BINARY_DIR}/browser-run
       --model-cache ${PROJECT_BINARY_DIR}/model-cache)
   set_tests_properties(browser_run_page PROPERTIES TIMEOUT 300 LABELS "ui;browser"
+    SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
+  # The bugs a new user hit (issue 29, Bugs): one check per bug, each failed before its fix.
+  add_test(NAME browser_ui_bugs
+    COMMAND ${SKETCHNAV_NODE} ${_browser_dir}/bugs.test.mjs
+      --sketchnav $<TARGET_FILE:sketchnav>
+      --out ${CMAKE_CURRENT_BINARY_DIR}/browser-bugs)
+  set_tests_properties(browser_ui_bugs PROPERTIES TIMEOUT 180 LABELS "ui;browser"
     SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
 endif()
