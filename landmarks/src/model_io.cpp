@@ -312,6 +312,8 @@ std::pair<int, int> LandmarkModel::globalOwner(int row) const {
 }
 
 void LandmarkModel::save(const std::string& path) const {
+  // The rename below would replace a device node or FIFO (`-o /dev/full` as root did).
+  requireOutputFile(path, "landmark model");
   Writer w;
   w.str(paramsToJson(params_).dump());
   w.str(fingerprint_);
