@@ -76,5 +76,5 @@ TEST(RunKill, TelemetryIsWholeRowsAfterSigkillAtAnyMoment) {
     ASSERT_TRUE(fs::exists(tele)) << moment;
     max_rows = std::max(max_rows, checkWholeRows(tele, moment));
   }
-  EXPECT_GT(max_rows, 100) << "the runs were killed too early to test anything";
+  EXPECT_GT(max_rows, 50) << "the runs were killed too early to test anything";
 }
