@@ -42,7 +42,7 @@ std::uint64_t requireRegularFileUpTo(const std::string& path, const std::string&
   struct stat st {};
   if (path.empty()) throw InputError(what + ": empty file name");
   if (::stat(path.c_str(), &st) != 0)
-    throw InputError(quoted(what, path) + ": cannot open (" + std::strerror(errno) + ")");
+    throw InputError(quoted(what, path) + " cannot be opened (" + std::strerror(errno) + ")");
   if (!S_ISREG(st.st_mode))
     throw InputError(quoted(what, path) + ": is " + kindOf(st.st_mode) +
                      ", expected a regular file");
