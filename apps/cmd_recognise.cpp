@@ -4,6 +4,7 @@
 
 #include <algorithm>
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <ctime>
 #include <filesystem>
@@ -65,7 +66,12 @@ struct Runner {
     const double s = std::min(static_cast<double>(frame_size.width) / img.cols,
                               static_cast<double>(frame_size.height) / img.rows);
     cv::Mat scaled, frame(frame_size, CV_8UC3, cv::Scalar(127, 127, 127));
-    cv::resize(img, scaled, cv::Size(), s, s, s < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
+    // At least 1 px on each side: a 1 x 4000 photo scaled by 0.12 would round to 0 px wide,
+    // which cv::resize refuses with an assertion.
+    const cv::Size to(
+        std::clamp(static_cast<int>(std::lround(img.cols * s)), 1, frame_size.width),
+        std::clamp(static_cast<int>(std::lround(img.rows * s)), 1, frame_size.height));
+    cv::resize(img, scaled, to, 0, 0, s < 1 ? cv::INTER_AREA : cv::INTER_LINEAR);
     scaled.copyTo(frame(cv::Rect((frame_size.width - scaled.cols) / 2,
                                  (frame_size.height - scaled.rows) / 2, scaled.cols, scaled.rows)));
     return frame;

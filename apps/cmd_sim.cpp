@@ -12,6 +12,7 @@
 
 #include "cli.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/sim/map_render.h"
@@ -68,9 +69,9 @@ Json poseJson(const hw::Pose2D& p) {
 
 std::string outputFile(const Args& args, const std::string& def_name) {
   if (args.has("output") && !args.get("output").empty()) {
-    const fs::path p = args.get("output");
-    if (p.has_parent_path()) fs::create_directories(p.parent_path());
-    return p.string();
+    // An explicit -o names a file in an existing folder: no parent folders are created.
+    requireOutputFile(args.get("output"), "sketchnav sim: -o");
+    return args.get("output");
   }
   return (fs::path(makeOutputDir(args.get("out"))) / def_name).string();
 }

@@ -6,6 +6,7 @@
 
 #include "cli.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/landmarks/model.h"
 
 namespace sketchnav::app {
@@ -28,6 +29,8 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   if (args.get("landmarks").empty())
     throw InputError("sketchnav train: --landmarks DIR is required");
   if (args.get("output").empty()) throw InputError("sketchnav train: -o MODEL is required");
+  // Checked before training: outputs go only to regular or new files in existing folders.
+  requireOutputFile(args.get("output"), "sketchnav train: -o");
 
   landmarks::ModelParams p;
   applyConfig(p, g.config, "landmarks.train");

@@ -145,8 +145,11 @@ class RunObserver final : public nav::ExecutiveObserver {
       events_.open(out + "/events.jsonl");
       tele_.open(out + "/telemetry.csv");
       if (!events_ || !tele_) throw RuntimeError("cannot write run files in " + out);
+      // Header flushed at open and every row written whole and flushed (one write()): a run
+      // killed at any moment leaves telemetry.csv readable to its last whole row.
       tele_ << "t,odom_x,odom_y,odom_theta,true_x,true_y,true_theta,v_cmd,w_cmd,servo_error,"
-               "mode,turn,section,landmark,front_free_m\n";
+               "mode,turn,section,landmark,front_free_m\n"
+            << std::flush;
     }
   }
   std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
@@ -211,15 +214,17 @@ class RunObserver final : public nav::ExecutiveObserver {
     last_truth = truth;
     odom.push_back(r.odom);
     if (tele_.is_open()) {
-      tele_ << r.t << ',' << r.odom.x << ',' << r.odom.y << ',' << r.odom.theta << ',';
+      std::ostringstream row;
+      row << r.t << ',' << r.odom.x << ',' << r.odom.y << ',' << r.odom.theta << ',';
       if (sim_)
-        tele_ << truth.x << ',' << truth.y << ',' << truth.theta << ',';
+        row << truth.x << ',' << truth.y << ',' << truth.theta << ',';
       else
-        tele_ << ",,,";
-      tele_ << r.v_cmd << ',' << r.w_cmd << ',';
-      if (std::isfinite(r.servo_error)) tele_ << r.servo_error;
-      tele_ << ',' << r.mode << ',' << r.turn << ',' << r.section << ',' << r.landmark << ','
-            << r.front_free_m << '\n';
+        row << ",,,";
+      row << r.v_cmd << ',' << r.w_cmd << ',';
+      if (std::isfinite(r.servo_error)) row << r.servo_error;
+      row << ',' << r.mode << ',' << r.turn << ',' << r.section << ',' << r.landmark << ','
+          << r.front_free_m << '\n';
+      tele_ << row.str() << std::flush;
     }
     if (progress_ && r.t >= next_progress_) {
       next_progress_ = r.t + 5.0;

@@ -19,4 +19,5 @@ set(LANDMARKS_RECOGNITION_TESTS
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_grocery.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_colour.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_recognition_sibling.cpp
-  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_photo_hash.cpp)
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_photo_hash.cpp
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_bad_input.cpp)

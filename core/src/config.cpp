@@ -1,5 +1,7 @@
 #include "sketchnav/core/config.h"
 
+#include "sketchnav/core/json_io.h"
+
 #include <fstream>
 #include <sstream>
 
@@ -27,15 +29,7 @@ Config Config::fromJson(const Json& j, const std::string& origin) {
 }
 
 Config Config::fromFile(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("config file '" + path + "' cannot be opened");
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const Json::parse_error& e) {
-    throw InputError("config file '" + path + "' is not valid JSON: " + e.what());
-  }
-  return fromJson(j, path);
+  return fromJson(parseJsonFile(path, "config file"), path);
 }
 
 void Config::set(const std::string& assignment) {

@@ -8,6 +8,7 @@
 #include <mutex>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 
 namespace sketchnav::log {
 namespace {
@@ -69,6 +70,8 @@ void setQuiet(bool q) {
 void setFile(const std::string& path) {
   std::lock_guard<std::mutex> lock(state().mutex);
   state().file.close();
+  // Appending to a FIFO would block and a device makes no sense: regular/new files only.
+  requireOutputFile(path, "--log-file");
   state().file.open(path, std::ios::app);
   if (!state().file) throw InputError("--log-file: cannot open '" + path + "' for writing");
 }

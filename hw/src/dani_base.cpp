@@ -128,6 +128,14 @@ struct DaniLink::Impl {
       session = h.session;
       hello_nonce = 0;
       base_seq = h.seq;
+      // The base's limits and geometry are robot-facing inputs: a value that is not finite (or
+      // out of range) is a fault, the session is told to stop and is never used.
+      if (const std::string bad = badWelcome(m.welcome); !bad.empty()) {
+        ++base_stats.dropped;
+        fault(t, "base Welcome: " + bad);
+        session = 0;  // nothing more from this session is accepted
+        return;
+      }
       welcome = m.welcome;
       st.connected = true;
       st.last_rx_t = t;
@@ -192,7 +200,31 @@ struct DaniLink::Impl {
     }
   }
 
+  static std::string badWelcome(const proto::WelcomeMsg& w) {
+    auto num = [](float v) { return std::to_string(v); };
+    if (!std::isfinite(w.max_v) || w.max_v <= 0) return "max_v " + num(w.max_v) + " m/s";
+    if (!std::isfinite(w.max_w) || w.max_w <= 0) return "max_w " + num(w.max_w) + " rad/s";
+    if (!std::isfinite(w.ticks_per_metre) || w.ticks_per_metre < 0)
+      return "ticks_per_metre " + num(w.ticks_per_metre);
+    if (!std::isfinite(w.track_width) || w.track_width < 0)
+      return "track_width " + num(w.track_width) + " m";
+    if (w.watchdog_ms == 0) return "watchdog_ms 0";
+    return {};
+  }
+
   void onOdom(const proto::OdomMsg& o, double t) {
+    if (o.has_pose) {
+      const float f[5] = {o.x, o.y, o.theta, o.v, o.w};
+      const char* names[5] = {"x", "y", "theta", "v", "w"};
+      for (int i = 0; i < 5; ++i)
+        if (!std::isfinite(f[i])) {
+          // Never integrate or relay it: a pose the laptop cannot trust stops the robot.
+          ++base_stats.dropped;
+          fault(t, std::string("base odometry ") + names[i] + " is not finite (" +
+                       std::to_string(f[i]) + ")");
+          return;
+        }
+    }
     ++base_stats.received;
     if (o.has_pose) {
       odom.pose = {o.x, o.y, o.theta};

@@ -8,8 +8,10 @@
 #include <unistd.h>
 
 #include <atomic>
+#include <cmath>
 #include <fstream>
 #include <functional>
+#include <limits>
 #include <random>
 #include <thread>
 
@@ -425,4 +427,126 @@ TEST(Dani, RegistryOpensBaseAndSonarOverOneLinkAndFailsFastWithoutABase) {
   const std::string secret = test::tempDir("dani") + "/short";
   std::ofstream(secret) << "abc";
   EXPECT_THROW(Registry::instance().createBase(uri + "?secret_file=" + secret, ctx2), InputError);
+}
+
+namespace {
+/// A hand-driven base: answers the link's Hello with a chosen Welcome and sends chosen
+/// stream messages, recording what the laptop sends.
+class RawBase {
+ public:
+  RawBase() {
+    fd_ = ::socket(AF_INET, SOCK_DGRAM, 0);
+    sockaddr_in a{};
+    a.sin_family = AF_INET;
+    ::inet_pton(AF_INET, "127.0.0.1", &a.sin_addr);
+    EXPECT_EQ(::bind(fd_, reinterpret_cast<sockaddr*>(&a), sizeof a), 0);
+    socklen_t len = sizeof a;
+    ::getsockname(fd_, reinterpret_cast<sockaddr*>(&a), &len);
+    port = ntohs(a.sin_port);
+  }
+  ~RawBase() { ::close(fd_); }
+  /// Next message of type `t` from the laptop within timeout.
+  bool expect(Type t, Message& out, double timeout_s = 1.0) {
+    SteadyClock c;
+    std::vector<std::uint8_t> buf(2048);
+    while (c.now() < timeout_s) {
+      pollfd p{fd_, POLLIN, 0};
+      if (::poll(&p, 1, 10) <= 0) continue;
+      socklen_t len = sizeof peer_;
+      const ssize_t n =
+          ::recvfrom(fd_, buf.data(), buf.size(), 0, reinterpret_cast<sockaddr*>(&peer_), &len);
+      if (n <= 0) continue;
+      if (proto::decode(buf.data(), static_cast<std::size_t>(n), out) == proto::DecodeError::None &&
+          out.header.type == t)
+        return true;
+    }
+    return false;
+  }
+  void send(Message m) {
+    m.header.session = session;
+    m.header.seq = ++seq;
+    const auto b = proto::encode(m);
+    ::sendto(fd_, b.data(), b.size(), 0, reinterpret_cast<sockaddr*>(&peer_), sizeof peer_);
+  }
+  /// Waits for Hello and answers `w` (its nonce filled in).
+  bool welcome(proto::WelcomeMsg w) {
+    Message hello;
+    if (!expect(Type::Hello, hello)) return false;
+    Message m = proto::makeMessage(Type::Welcome, session, 0);
+    w.hello_nonce = hello.header.session;
+    m.welcome = w;
+    send(m);
+    return true;
+  }
+  void running() {
+    Message m = proto::makeMessage(Type::Status, session, 0);
+    m.status.state = BaseState::Running;
+    send(m);
+  }
+  void odom(float x) {
+    Message m = proto::makeMessage(Type::Odom, session, 0);
+    m.odom.x = x;
+    m.odom.has_pose = true;
+    send(m);
+  }
+  int port = 0;
+  std::uint32_t session = 4242, seq = 0;
+
+ private:
+  int fd_ = -1;
+  sockaddr_in peer_{};
+};
+}  // namespace
+
+// Bad-input campaign (issue 28): NaN/inf odometry and NaN limits in the Welcome were reported
+// ok and used. A robot-facing value that is not finite is a fault that ends in Stop.
+TEST(Dani, NonFiniteOdometryIsAFaultThatStopsTheBase) {
+  for (const float bad :
+       {std::numeric_limits<float>::quiet_NaN(), std::numeric_limits<float>::infinity()}) {
+    RawBase fake;
+    DaniParams dp;
+    dp.link_timeout_s = 5;  // the fake base sends no periodic stream
+    auto link = std::make_shared<DaniLink>("127.0.0.1", fake.port, dp, nullptr, "");
+    ASSERT_TRUE(fake.welcome({}));
+    Message resume;
+    ASSERT_TRUE(fake.expect(Type::Resume, resume));
+    fake.running();
+    ASSERT_TRUE(link->connect(1.0)) << link->status().last_error;
+    fake.odom(0.5f);
+    Odometry o;
+    ASSERT_TRUE(waitFor([&] { return link->odometry(o) && link->ok(); }));
+    EXPECT_FLOAT_EQ(static_cast<float>(o.pose.x), 0.5f);
+    fake.odom(bad);
+    Message stop;
+    EXPECT_TRUE(fake.expect(Type::Stop, stop)) << "no Stop after non-finite odometry";
+    EXPECT_FALSE(link->ok());
+    EXPECT_NE(link->status().last_error.find("not finite"), std::string::npos)
+        << link->status().last_error;
+    link->command(0.3, 0.0);  // faulted and latched: never a CmdVel
+    Message cmd;
+    EXPECT_FALSE(fake.expect(Type::CmdVel, cmd, 0.2));
+    if (link->odometry(o)) EXPECT_TRUE(std::isfinite(o.pose.x));
+  }
+}
+
+TEST(Dani, NonFiniteLimitsInTheWelcomeAreAFaultThatStopsTheBase) {
+  RawBase fake;
+  DaniParams dp;
+  dp.resume_on_connect = false;  // connect() then needs only the session
+  dp.link_timeout_s = 5;
+  auto link = std::make_shared<DaniLink>("127.0.0.1", fake.port, dp, nullptr, "");
+  proto::WelcomeMsg w;
+  w.max_v = std::numeric_limits<float>::quiet_NaN();
+  ASSERT_TRUE(fake.welcome(w));
+  Message stop;
+  EXPECT_TRUE(fake.expect(Type::Stop, stop)) << "no Stop after a NaN max_v";
+  EXPECT_FALSE(link->connect(0.3));
+  EXPECT_FALSE(link->ok());
+  EXPECT_NE(link->status().last_error.find("max_v"), std::string::npos)
+      << link->status().last_error;
+  fake.running();
+  fake.odom(1.0f);  // the refused session's stream is not used
+  sleepS(0.05);
+  Odometry o;
+  EXPECT_FALSE(link->odometry(o));
 }

@@ -2,6 +2,9 @@
 #include <cctype>
 #include <filesystem>
 #include <map>
+#include <set>
+
+#include <sys/stat.h>
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
@@ -32,7 +35,15 @@ LandmarkSet scanLandmarkSet(const std::string& root) {
   LandmarkSet set;
   set.root = fs::canonical(root).string();
   std::map<std::string, std::vector<std::string>> classes;
-  // Walk every folder; a folder without sub-folders is a class.
+  // Walk every folder; a folder without sub-folders is a class. Each directory (by device and
+  // inode, so symlinks are followed but `A/loop -> ..` is not walked again) is visited once.
+  std::set<std::pair<dev_t, ino_t>> visited;
+  auto firstVisit = [&visited](const fs::path& p) {
+    struct stat st {};
+    if (::stat(p.c_str(), &st) != 0) return false;
+    return visited.insert({st.st_dev, st.st_ino}).second;
+  };
+  firstVisit(set.root);
   std::vector<fs::path> stack{fs::path(set.root)};
   while (!stack.empty()) {
     const fs::path dir = stack.back();
@@ -40,9 +51,12 @@ LandmarkSet scanLandmarkSet(const std::string& root) {
     std::vector<fs::path> subdirs, files;
     for (const auto& e :
          fs::directory_iterator(dir, fs::directory_options::skip_permission_denied, ec)) {
-      if (e.is_directory(ec))
-        subdirs.push_back(e.path());
-      else if (e.is_regular_file(ec))
+      if (e.is_directory(ec)) {
+        if (firstVisit(e.path()))
+          subdirs.push_back(e.path());
+        else
+          set.skipped.push_back(e.path().string() + ": folder already visited (symlink loop?)");
+      } else if (e.is_regular_file(ec))
         files.push_back(e.path());
     }
     if (!subdirs.empty()) {

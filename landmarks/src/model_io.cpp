@@ -14,6 +14,7 @@
 // After flann.hpp, which it needs (cvflann::seed_random).
 #include <opencv2/flann/random.h>
 
+#include <cmath>
 #include <cstring>
 #include <filesystem>
 #include <fstream>
@@ -25,6 +26,8 @@
 
 #include "model_internal.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
+#include "sketchnav/core/json_io.h"
 #include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/model.h"
 
@@ -32,6 +35,8 @@ namespace sketchnav::landmarks {
 
 namespace {
 constexpr char kMagic[8] = {'S', 'K', 'N', 'V', 'L', 'M', 'D', 'L'};
+constexpr int kSiftDims = 128;                        // SIFT descriptor length
+constexpr std::uint64_t kMaxModelBytes = 4ull << 30;  // largest model file read [bytes]
 
 class Writer {
  public:
@@ -76,10 +81,18 @@ class Reader {
     p_ += n;
     return s;
   }
-  cv::Mat mat() {
+  /// A matrix field named `field` in errors. Its declared size is checked against the bytes
+  /// left before anything is allocated (a corrupt header must not ask for gigabytes).
+  cv::Mat mat(const std::string& field) {
     const int rows = get<std::int32_t>(), cols = get<std::int32_t>(), type = get<std::int32_t>();
     if (rows < 0 || cols < 0 || (type != CV_32F && type != CV_8U && type != CV_32S))
-      corrupt("bad matrix header");
+      corrupt(field + ": bad matrix header");
+    const size_t esz = type == CV_8U ? 1 : 4;
+    if (rows > 0 && cols > 0 &&
+        static_cast<size_t>(cols) > remaining() / static_cast<size_t>(rows) / esz)
+      corrupt(field + ": " + std::to_string(rows) + " x " + std::to_string(cols) +
+              " matrix runs past the end of the payload");
+    if (rows == 0 || cols == 0) return cv::Mat(rows, cols, type);
     cv::Mat m(rows, cols, type);
     const size_t n = m.total() * m.elemSize();
     need(n);
@@ -88,6 +101,14 @@ class Reader {
     return m;
   }
   bool atEnd() const { return p_ == end_; }
+  size_t remaining() const { return static_cast<size_t>(end_ - p_); }
+  /// A count of items of at least `min_bytes` each that must fit in what is left.
+  std::uint32_t count(const std::string& field, size_t min_bytes) {
+    const auto n = get<std::uint32_t>();
+    if (static_cast<size_t>(n) > remaining() / min_bytes)
+      corrupt(field + ": count " + std::to_string(n) + " runs past the end of the payload");
+    return n;
+  }
   [[noreturn]] void corrupt(const std::string& why) const {
     throw InputError(file_ + ": corrupt landmark model (" + why +
                      "); retrain with "
@@ -102,6 +123,22 @@ class Reader {
   const char* end_;
   std::string file_;
 };
+/// The elements of a continuous matrix of type `type` with exactly `n` elements, else a
+/// corrupt-model error naming `field`. Never iterates an empty or mistyped matrix.
+template <class T>
+std::vector<T> elements(const Reader& r, const cv::Mat& m, int type, size_t n,
+                        const std::string& field) {
+  if (m.total() != n || (n > 0 && m.type() != type))
+    r.corrupt(field + ": expected " + std::to_string(n) + " values, got " +
+              std::to_string(m.total()));
+  if (n == 0) return {};
+  const T* p = m.ptr<T>(0);
+  return std::vector<T>(p, p + n);
+}
+
+bool finite(float v) {
+  return std::isfinite(v);
+}
 }  // namespace
 
 struct LandmarkModel::Cache {
@@ -275,6 +312,8 @@ std::pair<int, int> LandmarkModel::globalOwner(int row) const {
 }
 
 void LandmarkModel::save(const std::string& path) const {
+  // The rename below would replace a device node or FIFO (`-o /dev/full` as root did).
+  requireOutputFile(path, "landmark model");
   Writer w;
   w.str(paramsToJson(params_).dump());
   w.str(fingerprint_);
@@ -337,9 +376,12 @@ void LandmarkModel::save(const std::string& path) const {
 }
 
 LandmarkModel LandmarkModel::load(const std::string& path) {
-  std::ifstream in(path, std::ios::binary);
-  if (!in) throw InputError(path + ": landmark model not found or unreadable");
-  std::string data((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+  // A directory, FIFO or device is refused before it is opened; the size is bounded before
+  // the file is read whole.
+  std::error_code ec;
+  if (!std::filesystem::exists(path, ec))
+    throw InputError(path + ": landmark model not found or unreadable");
+  const std::string data = readInputFile(path, "landmark model", kMaxModelBytes);
   constexpr size_t kHeader = 8 + 4 + 8 + 8;
   if (data.size() < 8 || std::memcmp(data.data(), kMagic, 8) != 0)
     throw InputError(path + ": not a sketchnav landmark model (.slm)");
@@ -362,48 +404,79 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
   if (detail::fnv1a(payload, size) != sum)
     throw InputError(path + ": corrupt landmark model (checksum mismatch)");
 
+  // The checksum catches accidents, not a crafted file: every size below is checked before use.
   Reader r(payload, size, path);
   LandmarkModel m;
-  try {
-    applyConfig(m.params_, Config::fromJson(Json::parse(r.str()), path), "");
-  } catch (const Json::exception&) {
-    r.corrupt("bad parameter block");
+  {
+    const std::string params = r.str();
+    Json pj;
+    try {
+      pj = parseJsonText(params, "parameter block");
+    } catch (const InputError& e) {
+      r.corrupt(e.what());
+    }
+    if (!pj.is_object()) r.corrupt("parameter block: not a JSON object");
+    try {
+      applyConfig(m.params_, Config::fromJson(pj, path), "");
+    } catch (const InputError& e) {
+      throw InputError(path + ": landmark model parameter block: " + clipForMessage(e.what(), 200));
+    } catch (const Json::exception& e) {
+      r.corrupt(std::string("parameter block: ") + clipForMessage(e.what(), 120));
+    }
   }
   m.fingerprint_ = r.str();
-  const auto n_classes = r.get<std::uint32_t>();
+  const auto n_classes = r.count("class count", 8);
+  if (n_classes < 1) r.corrupt("class count: 0");
   for (std::uint32_t i = 0; i < n_classes; ++i) m.classes_.push_back(r.str());
-  cv::Mat centres = r.mat(), idf = r.mat();
-  if (centres.type() != CV_32F || idf.total() != static_cast<size_t>(centres.rows))
-    r.corrupt("vocabulary");
-  m.vocabulary_ =
-      Vocabulary::fromCentres(centres, std::vector<float>(idf.begin<float>(), idf.end<float>()));
-  m.classifier_.weights = r.mat();
-  cv::Mat rho = r.mat();
-  m.classifier_.rho.assign(rho.begin<float>(), rho.end<float>());
+  cv::Mat centres = r.mat("vocabulary centres"), idf = r.mat("vocabulary idf");
+  if (centres.type() != CV_32F || centres.rows < 1 || centres.cols != kSiftDims)
+    r.corrupt("vocabulary centres: expected K x " + std::to_string(kSiftDims) + " floats, K >= 1");
+  const std::vector<float> idf_v =
+      elements<float>(r, idf, CV_32F, static_cast<size_t>(centres.rows), "vocabulary idf");
+  for (float v : idf_v)
+    if (!finite(v)) r.corrupt("vocabulary idf: not finite");
+  m.vocabulary_ = Vocabulary::fromCentres(centres, idf_v);
+  m.classifier_.weights = r.mat("classifier weights");
+  cv::Mat rho = r.mat("classifier rho");
   m.classifier_.platt_a = r.get<float>();
   m.classifier_.platt_b = r.get<float>();
-  if (m.classifier_.weights.rows != static_cast<int>(n_classes) ||
-      m.classifier_.weights.cols != centres.rows || rho.total() != n_classes)
-    r.corrupt("classifier");
-  m.colour_classifier_.weights = r.mat();
-  cv::Mat colour_rho = r.mat();
+  if (m.classifier_.weights.type() != CV_32F ||
+      m.classifier_.weights.rows != static_cast<int>(n_classes) ||
+      m.classifier_.weights.cols != centres.rows)
+    r.corrupt("classifier weights: expected " + std::to_string(n_classes) + " x " +
+              std::to_string(centres.rows) + " floats");
+  m.classifier_.rho = elements<float>(r, rho, CV_32F, n_classes, "classifier rho");
+  if (!finite(m.classifier_.platt_a) || !finite(m.classifier_.platt_b))
+    r.corrupt("classifier Platt scaling: not finite");
+  m.colour_classifier_.weights = r.mat("colour classifier weights");
+  cv::Mat colour_rho = r.mat("colour classifier rho");
   if (m.colour_classifier_.weights.type() != CV_32F ||
       m.colour_classifier_.weights.rows != static_cast<int>(n_classes) ||
-      m.colour_classifier_.weights.cols != kColourLayoutDims || colour_rho.total() != n_classes ||
-      colour_rho.type() != CV_32F)
-    r.corrupt("colour classifier");
-  m.colour_classifier_.rho.assign(colour_rho.begin<float>(), colour_rho.end<float>());
+      m.colour_classifier_.weights.cols != kColourLayoutDims)
+    r.corrupt("colour classifier weights: expected " + std::to_string(n_classes) + " x " +
+              std::to_string(kColourLayoutDims) + " floats");
+  m.colour_classifier_.rho =
+      elements<float>(r, colour_rho, CV_32F, n_classes, "colour classifier rho");
   m.colour_classifier_.platt_a = r.get<float>();
   m.colour_classifier_.platt_b = r.get<float>();
-  const auto n_photos = r.get<std::uint32_t>();
+  if (!finite(m.colour_classifier_.platt_a) || !finite(m.colour_classifier_.platt_b))
+    r.corrupt("colour classifier Platt scaling: not finite");
+  // A photo record is at least class + path length + size + keypoint count + 4 matrix headers.
+  constexpr size_t kMinPhotoBytes = 4 + 8 + 8 + 4 + 4 * 12;
+  constexpr size_t kKeypointBytes = 6 * 4;
+  const auto n_photos = r.count("photo count", kMinPhotoBytes);
   m.photos_.resize(n_photos);
-  for (auto& ph : m.photos_) {
+  for (std::uint32_t i = 0; i < n_photos; ++i) {
+    auto& ph = m.photos_[i];
+    const std::string f = "photo " + std::to_string(i);
     ph.class_id = r.get<std::int32_t>();
-    if (ph.class_id < 0 || ph.class_id >= static_cast<int>(n_classes)) r.corrupt("photo class");
+    if (ph.class_id < 0 || ph.class_id >= static_cast<int>(n_classes))
+      r.corrupt(f + " class: " + std::to_string(ph.class_id) + " is not a class index");
     ph.path = r.str();
     ph.size.width = r.get<std::int32_t>();
     ph.size.height = r.get<std::int32_t>();
-    const auto nk = r.get<std::uint32_t>();
+    if (ph.size.width < 0 || ph.size.height < 0) r.corrupt(f + " size: negative");
+    const auto nk = r.count(f + " keypoint count", kKeypointBytes);
     ph.keypoints.resize(nk);
     for (auto& k : ph.keypoints) {
       k.pt.x = r.get<float>();
@@ -412,20 +485,31 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
       k.angle = r.get<float>();
       k.response = r.get<float>();
       k.octave = r.get<std::int32_t>();
+      if (!finite(k.pt.x) || !finite(k.pt.y) || !finite(k.size) || !finite(k.angle) ||
+          !finite(k.response))
+        r.corrupt(f + " keypoints: not finite");
     }
-    ph.sift_u8 = r.mat();
-    ph.colours = r.mat();
-    cv::Mat words = r.mat();
-    if (ph.sift_u8.rows != static_cast<int>(nk) || words.total() != nk ||
-        ph.colours.rows != static_cast<int>(nk) || ph.colours.cols != 3)
-      r.corrupt("photo");
-    ph.words.assign(words.begin<int>(), words.end<int>());
+    ph.sift_u8 = r.mat(f + " descriptors");
+    ph.colours = r.mat(f + " keypoint colours");
+    cv::Mat words = r.mat(f + " words");
+    if (nk > 0 && (ph.sift_u8.type() != CV_8U || ph.sift_u8.rows != static_cast<int>(nk) ||
+                   ph.sift_u8.cols != kSiftDims))
+      r.corrupt(f + " descriptors: expected " + std::to_string(nk) + " x " +
+                std::to_string(kSiftDims) + " bytes");
+    if (nk > 0 && (ph.colours.type() != CV_8U || ph.colours.rows != static_cast<int>(nk) ||
+                   ph.colours.cols != 3))
+      r.corrupt(f + " keypoint colours: expected " + std::to_string(nk) + " x 3 bytes");
+    if (nk == 0) {
+      ph.sift_u8 = cv::Mat(0, kSiftDims, CV_8U);
+      ph.colours = cv::Mat(0, 3, CV_8U);
+    }
+    ph.words = elements<int>(r, words, CV_32S, nk, f + " words");
     for (int wd : ph.words)
-      if (wd < 0 || wd >= centres.rows) r.corrupt("word index");
-    cv::Mat thumb = r.mat();
-    if (thumb.type() != CV_8U || thumb.cols % 3 != 0 || thumb.rows > kPhotoThumbnailSide ||
-        thumb.cols > 3 * kPhotoThumbnailSide)
-      r.corrupt("photo thumbnail");
+      if (wd < 0 || wd >= centres.rows) r.corrupt(f + " words: index out of the vocabulary");
+    cv::Mat thumb = r.mat(f + " thumbnail");
+    if ((!thumb.empty() && thumb.type() != CV_8U) || thumb.cols % 3 != 0 ||
+        thumb.rows > kPhotoThumbnailSide || thumb.cols > 3 * kPhotoThumbnailSide)
+      r.corrupt(f + " thumbnail");
     if (!thumb.empty()) ph.thumbnail = thumb.reshape(3);
   }
   if (!r.atEnd()) r.corrupt("trailing bytes");

@@ -7,6 +7,8 @@
 
 #include "geometry.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
+#include "sketchnav/core/json_io.h"
 #include "sketchnav/mapsketch/io.h"
 
 namespace fs = std::filesystem;
@@ -270,15 +272,7 @@ Sketch sketchFromText(const std::string& text, const std::string& origin) {
   if (text.size() > kMaxSketchBytes)
     throw InputError(origin + ": too large (" + std::to_string(text.size()) + " bytes > " +
                      std::to_string(kMaxSketchBytes) + ")");
-  Json j;
-  try {
-    j = Json::parse(text);
-  } catch (const Json::parse_error& e) {
-    // nlohmann's message carries the byte position; drop its "[json.exception...]" prefix.
-    std::string what = e.what();
-    if (auto p = what.find("] "); p != std::string::npos) what = what.substr(p + 2);
-    throw InputError(origin + ": not valid JSON: " + what);
-  }
+  const Json j = parseJsonText(text, origin);
   return sketchFromJson(j, origin);
 }
 

@@ -303,3 +303,30 @@ TEST(Examples, LabSketchFollowsThePapersRoute) {
   EXPECT_EQ(r.goal_place.kind, GoalPlace::Kind::Doorway);
   EXPECT_DOUBLE_EQ(r.goal_place.standoff_m, 0.6);
 }
+
+// Bad-input campaign (issue 28): deep nesting and 1e400 name the file, never a bare library
+// message; huge values are quoted only in part.
+TEST(SketchValidation, DeepNestingAndNumberOverflowNameTheFile) {
+  const std::string deep =
+      "{\"format\": " + std::string(100000, '[') + std::string(100000, ']') + "}";
+  try {
+    sketchFromText(deep, "deep.sketch.json");
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("deep.sketch.json: JSON nested deeper"), std::string::npos)
+        << e.what();
+  }
+  const std::string dir = test::tempDir("sketch_overflow");
+  const std::string p = dir + "/big.sketch.json";
+  std::string text = sketchToJson(fixtures::lSketch()).dump();
+  text.replace(text.find("\"distance_m\":") + 13, 0, "1e400,\"x\":");
+  std::ofstream(p) << text;
+  try {
+    loadSketch(p);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(p), std::string::npos) << m;
+    EXPECT_NE(m.find("overflow"), std::string::npos) << m;
+  }
+}

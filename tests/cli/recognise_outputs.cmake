@@ -76,3 +76,8 @@ expect(2 "--plot folder '${WORK}/missing' does not exist" recognise --model ${WO
        --eval ${WORK}/eval --plot ${WORK}/missing/x.png)
 expect(2 "--annotate is for IMAGE" recognise --model ${WORK}/demo.slm --eval ${WORK}/eval
        --annotate ${WORK}/x)
+# 1 x 4000 and 4000 x 1 photos (issue 28: an OpenCV resize assertion, exit 1) are letterboxed
+# to at least 1 px and simply not recognised.
+run_ok(out err --json recognise --model ${WORK}/demo.slm --frame 640x480
+       ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_1x4000.png
+       ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_4000x1.png)

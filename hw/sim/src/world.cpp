@@ -9,6 +9,8 @@
 
 #include "geometry.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
+#include "sketchnav/core/json_io.h"
 #include "sketchnav/core/paths.h"
 
 namespace fs = std::filesystem;
@@ -44,7 +46,7 @@ class Reader {
       if (required) fail(key, "is required");
       return def;
     }
-    if (!v->is_number()) fail(key, "must be a number (got " + v->dump() + ")");
+    if (!v->is_number()) fail(key, "must be a number (got " + clipForMessage(v->dump()) + ")");
     const double x = v->get<double>();
     if (!std::isfinite(x)) fail(key, "must be finite");
     return x;
@@ -52,13 +54,15 @@ class Reader {
   int integer(const std::string& key, int def) {
     const Json* v = child(key);
     if (!v) return def;
-    if (!v->is_number_integer()) fail(key, "must be an integer (got " + v->dump() + ")");
+    if (!v->is_number_integer())
+      fail(key, "must be an integer (got " + clipForMessage(v->dump()) + ")");
     return v->get<int>();
   }
   bool boolean(const std::string& key, bool def) {
     const Json* v = child(key);
     if (!v) return def;
-    if (!v->is_boolean()) fail(key, "must be true or false (got " + v->dump() + ")");
+    if (!v->is_boolean())
+      fail(key, "must be true or false (got " + clipForMessage(v->dump()) + ")");
     return v->get<bool>();
   }
   std::string str(const std::string& key, const std::string& def, bool required = false) {
@@ -67,7 +71,7 @@ class Reader {
       if (required) fail(key, "is required");
       return def;
     }
-    if (!v->is_string()) fail(key, "must be a string (got " + v->dump() + ")");
+    if (!v->is_string()) fail(key, "must be a string (got " + clipForMessage(v->dump()) + ")");
     return v->get<std::string>();
   }
   Vec2 vec2(const std::string& key, const Vec2& def, bool required = false) {
@@ -80,7 +84,8 @@ class Reader {
   }
   Vec2 toVec2(const Json& v, const std::string& f) const {
     if (!v.is_array() || v.size() != 2 || !v[0].is_number() || !v[1].is_number())
-      throw InputError(origin_ + ": " + f + ": must be [x, y] in metres (got " + v.dump() + ")");
+      throw InputError(origin_ + ": " + f + ": must be [x, y] in metres (got " +
+                       clipForMessage(v.dump()) + ")");
     return {v[0].get<double>(), v[1].get<double>()};
   }
   std::vector<Vec2> points(const std::string& key, size_t min_count) {
@@ -276,11 +281,15 @@ World worldFromJson(const Json& j, const std::string& origin, const std::string&
     it.check(!l.class_name.empty(), "class", "must not be empty");
     const std::string tex = it.str("texture", "", true);
     l.texture = resolveTexture(tex, base_dir);
-    it.check(!l.texture.empty(), "texture", "file '" + tex + "' not found");
+    it.check(!l.texture.empty(), "texture", "file '" + clipForMessage(tex) + "' not found");
+    it.check(l.texture.empty() || fs::is_regular_file(l.texture), "texture",
+             "'" + clipForMessage(tex) + "' is not a regular file");
     const std::string back = it.str("back_texture", "");
     l.back_texture = resolveTexture(back, base_dir);
     it.check(back.empty() || !l.back_texture.empty(), "back_texture",
-             "file '" + back + "' not found");
+             "file '" + clipForMessage(back) + "' not found");
+    it.check(l.back_texture.empty() || fs::is_regular_file(l.back_texture), "back_texture",
+             "'" + clipForMessage(back) + "' is not a regular file");
     l.position = it.vec2("position", {}, true);
     l.yaw = it.num("yaw_deg", 0, true) * kDeg;
     l.width = it.num("width", l.width);
@@ -450,15 +459,7 @@ World worldFromJson(const Json& j, const std::string& origin, const std::string&
 }
 
 World loadWorld(const std::string& path) {
-  std::ifstream in(path);
-  if (!in) throw InputError("world file '" + path + "': cannot open");
-  Json j;
-  try {
-    j = Json::parse(in);
-  } catch (const std::exception& e) {
-    std::string msg = e.what();
-    throw InputError("world file '" + path + "': invalid JSON: " + msg);
-  }
+  const Json j = parseJsonFile(path, "world file");
   return worldFromJson(j, path, fs::path(path).parent_path().string());
 }
 

@@ -9,6 +9,8 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <sys/stat.h>
+
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -914,4 +916,49 @@ TEST(LabRendering, RenderedLandmarksMatchTheirDatabasePhotos) {
     cv::findHomography(src, dst, cv::RANSAC, 4.0, inliers);
     EXPECT_GE(cv::countNonZero(inliers), 8) << l.id << " " << l.class_name;
   }
+}
+
+// Bad-input campaign (issue 28): a world nested 100,000 deep crashed `sim map` (SIGSEGV);
+// a FIFO as world or texture blocked for ever; a 30,000-element value was quoted whole.
+TEST(WorldValidation, DeepNestingIsAnInputErrorNamingTheFile) {
+  const std::string dir = test::tempDir("world_deep");
+  std::string text = minimalWorldJson().dump();
+  const std::string deep = std::string(100000, '[') + std::string(100000, ']');
+  text.replace(text.find("[0,0]"), 5, deep);
+  const std::string p = dir + "/deep.world.json";
+  std::ofstream(p) << text;
+  try {
+    sim::loadWorld(p);
+    ADD_FAILURE() << "accepted";
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find(p), std::string::npos) << m;
+    EXPECT_NE(m.find("nested deeper than"), std::string::npos) << m;
+  }
+}
+
+TEST(WorldValidation, SpecialFilesAreRefused) {
+  const std::string dir = test::tempDir("world_fifo");
+  const std::string fifo = dir + "/pipe.world.json";
+  ::unlink(fifo.c_str());
+  ASSERT_EQ(::mkfifo(fifo.c_str(), 0600), 0);
+  EXPECT_THROW(sim::loadWorld(fifo), InputError);
+  EXPECT_THROW(sim::loadWorld(dir), InputError);
+  const std::string tex = dir + "/pipe.jpg";
+  ::unlink(tex.c_str());
+  ASSERT_EQ(::mkfifo(tex.c_str(), 0600), 0);
+  Json j = minimalWorldJson();
+  j["landmarks"][0]["texture"] = tex;
+  const std::string m = loadError(j);
+  EXPECT_NE(m.find("texture"), std::string::npos) << m;
+  EXPECT_NE(m.find("not a regular file"), std::string::npos) << m;
+}
+
+TEST(WorldValidation, HugeValuesAreQuotedInPart) {
+  Json j = minimalWorldJson();
+  j["start"]["x"] = Json::array();
+  for (int i = 0; i < 30000; ++i) j["start"]["x"].push_back(i);
+  const std::string m = loadError(j);
+  EXPECT_NE(m.find("start"), std::string::npos) << m;
+  EXPECT_LT(m.size(), 400u);
 }

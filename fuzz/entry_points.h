@@ -1,0 +1,22 @@
+#pragma once
+// The parsers' fuzzing entry points, shared by the libFuzzer harnesses (fuzz_*.cpp, preset
+// `fuzz`) and the normal regression test that replays fuzz/regressions/ and the seeds
+// (test_fuzz_corpus). Each returns normally for input that is accepted or refused with an
+// InputError; anything else (a crash, another exception, a sanitizer report) is a finding.
+#include <cstddef>
+#include <cstdint>
+#include <string>
+
+namespace sketchnav::fuzz {
+
+void sketch(const std::uint8_t* data, std::size_t size);
+void world(const std::uint8_t* data, std::size_t size);
+void config(const std::uint8_t* data, std::size_t size);
+void model(const std::uint8_t* data, std::size_t size);
+void baseProtocol(const std::uint8_t* data, std::size_t size);
+
+/// The entry point named "sketch", "world", "config", "model" or "protocol"; nullptr if none.
+using EntryPoint = void (*)(const std::uint8_t*, std::size_t);
+EntryPoint byName(const std::string& name);
+
+}  // namespace sketchnav::fuzz
