@@ -1,9 +1,11 @@
 // The union of CCS and SCS windows (objectness.h).
 #include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include "sketchnav/landmarks/baselines.h"
 #include "sketchnav/landmarks/objectness.h"
 
 namespace sketchnav::landmarks {
@@ -16,6 +18,8 @@ const char* toString(Window::Source s) {
       return "scs";
     case Window::Both:
       return "both";
+    case Window::Edges:
+      return "edges";
   }
   return "?";
 }
@@ -27,6 +31,10 @@ void ObjectnessParams::validate() const {
   require(nms_iou > 0 && nms_iou <= 1, "objectness.nms_iou", "must be in (0, 1]");
   require(both_iou > 0 && both_iou <= 1, "objectness.both_iou", "must be in (0, 1]");
   require(min_side >= 1, "objectness.min_side", "must be >= 1 px");
+  require(edgeboxes_max >= 1 && edgeboxes_max <= 100000, "objectness.edgeboxes_max",
+          "must be in [1, 100000]");
+  require(edgeboxes_min_area_frac >= 0 && edgeboxes_min_area_frac < 1,
+          "objectness.edgeboxes_min_area_frac", "must be in [0, 1)");
   ccs.validate();
   scs.validate();
 }
@@ -114,6 +122,22 @@ std::vector<Window> Objectness::propose(const cv::Mat& input, int max_windows) c
           src[i] = Window::Both;
           break;
         }
+    }
+  }
+  if (p.use_edgeboxes) {
+    cv::Mat mag, orient;
+    sobelEdges(bgr, mag, orient);
+    auto eb = cv::ximgproc::createEdgeBoxes();
+    eb->setMaxBoxes(p.edgeboxes_max);
+    eb->setMinBoxArea(static_cast<float>(p.edgeboxes_min_area_frac * bgr.cols * bgr.rows));
+    std::vector<cv::Rect> eboxes;
+    std::vector<float> escores;
+    eb->getBoundingBoxes(mag, orient, eboxes, escores);
+    for (const auto& r : eboxes) {
+      const cv::Rect c = r & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      if (c.area() <= 0) continue;
+      boxes.push_back({c, static_cast<float>(scorer.score(c) + p.edgeboxes_bonus)});
+      src.push_back(Window::Edges);
     }
   }
   // Drop windows too small to be useful at the working resolution.

@@ -27,7 +27,7 @@ namespace sketchnav::landmarks {
 
 /// One candidate window, in the input image's pixel coordinates.
 struct Window {
-  enum Source { CCS, SCS, Both };
+  enum Source { CCS, SCS, Both, Edges };  // Edges: EdgeBoxes on the working image's edges
   cv::Rect box;
   float score = 0.f;  // higher = more object-like; comparable across sources
   Source source = SCS;
@@ -36,14 +36,19 @@ struct Window {
 const char* toString(Window::Source s);
 
 struct ObjectnessParams {
-  int work_long_side = 200;  // px: long side of the working image (both methods)
-  bool use_ccs = true;       // run the CCS method
-  bool use_scs = true;       // run the SCS method
-  double nms_iou = 0.85;     // NMS overlap above which the lower-scored window is suppressed
-  double both_iou = 0.8;     // CCS and SCS windows this similar count as found by both
-  double ccs_bonus = 0.05;   // added to the SS score of CCS windows
-  double both_bonus = 0.05;  // added when both methods found the window
-  int min_side = 4;          // px at working resolution: smaller windows are dropped
+  int work_long_side = 200;      // px: long side of the working image (both methods)
+  bool use_ccs = true;           // run the CCS method
+  bool use_scs = true;           // run the SCS method
+  double nms_iou = 0.85;         // NMS overlap above which the lower-scored window is suppressed
+  double both_iou = 0.8;         // CCS and SCS windows this similar count as found by both
+  double ccs_bonus = 0.05;       // added to the SS score of CCS windows
+  double both_bonus = 0.05;      // added when both methods found the window
+  int min_side = 4;              // px at working resolution: smaller windows are dropped
+  bool use_edgeboxes = false;    // add EdgeBoxes (cv::ximgproc) windows on the working image's
+                                 // NMS-thinned Sobel edges (baselines.h sobelEdges)
+  int edgeboxes_max = 300;       // EdgeBoxes windows added per frame
+  double edgeboxes_bonus = 0.0;  // added to the SS score of EdgeBoxes windows
+  double edgeboxes_min_area_frac = 0.0015;  // EdgeBoxes' smallest box, fraction of the image
   CcsParams ccs;
   ScsParams scs;
 
@@ -57,6 +62,10 @@ struct ObjectnessParams {
     b("ccs_bonus", ccs_bonus);
     b("both_bonus", both_bonus);
     b("min_side", min_side);
+    b("use_edgeboxes", use_edgeboxes);
+    b("edgeboxes_max", edgeboxes_max);
+    b("edgeboxes_bonus", edgeboxes_bonus);
+    b("edgeboxes_min_area_frac", edgeboxes_min_area_frac);
   }
   /// Checks these fields and the nested ccs / scs params; throws InputError naming the field.
   void validate() const;
