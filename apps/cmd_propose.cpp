@@ -60,6 +60,7 @@ std::unique_ptr<ProposalMethod> makeMethod(const std::string& name, const Object
     ObjectnessParams q = p;
     q.use_ccs = name == "ccs";
     q.use_scs = name == "scs";
+    q.use_edgeboxes = false;  // one method alone
     return std::make_unique<Ours>(name, q);
   }
   if (name == "bing") return makeBing(bing_dir, scratch);

@@ -35,6 +35,10 @@ void ObjectnessParams::validate() const {
           "must be in [1, 100000]");
   require(edgeboxes_min_area_frac >= 0 && edgeboxes_min_area_frac < 1,
           "objectness.edgeboxes_min_area_frac", "must be in [0, 1)");
+  require(edgeboxes_alpha > 0 && edgeboxes_alpha < 1, "objectness.edgeboxes_alpha",
+          "must be in (0, 1)");
+  require(edgeboxes_long_side >= 16 && edgeboxes_long_side <= 2048,
+          "objectness.edgeboxes_long_side", "must be in [16, 2048] px");
   ccs.validate();
   scs.validate();
 }
@@ -125,16 +129,28 @@ std::vector<Window> Objectness::propose(const cv::Mat& input, int max_windows) c
     }
   }
   if (p.use_edgeboxes) {
+    // EdgeBoxes' cost grows with the pixel count and the candidate count: it may run on a
+    // smaller copy of the working image; its boxes are scaled back to working pixels.
+    const double es =
+        std::min(1.0, static_cast<double>(p.edgeboxes_long_side) / std::max(bgr.cols, bgr.rows));
+    cv::Mat small;
+    if (es < 1.0)
+      cv::resize(bgr, small, cv::Size(), es, es, cv::INTER_AREA);
+    else
+      small = bgr;
     cv::Mat mag, orient;
-    sobelEdges(bgr, mag, orient);
-    auto eb = cv::ximgproc::createEdgeBoxes();
+    sobelEdges(small, mag, orient);
+    auto eb = cv::ximgproc::createEdgeBoxes(static_cast<float>(p.edgeboxes_alpha));
     eb->setMaxBoxes(p.edgeboxes_max);
-    eb->setMinBoxArea(static_cast<float>(p.edgeboxes_min_area_frac * bgr.cols * bgr.rows));
+    eb->setMinBoxArea(static_cast<float>(p.edgeboxes_min_area_frac * small.cols * small.rows));
     std::vector<cv::Rect> eboxes;
     std::vector<float> escores;
     eb->getBoundingBoxes(mag, orient, eboxes, escores);
+    const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
     for (const auto& r : eboxes) {
-      const cv::Rect c = r & cv::Rect(0, 0, bgr.cols, bgr.rows);
+      const cv::Rect c = cv::Rect(cvRound(r.x / es), cvRound(r.y / es), cvRound(r.width / es),
+                                  cvRound(r.height / es)) &
+                         frame;
       if (c.area() <= 0) continue;
       boxes.push_back({c, static_cast<float>(scorer.score(c) + p.edgeboxes_bonus)});
       src.push_back(Window::Edges);

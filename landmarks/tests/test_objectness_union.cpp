@@ -81,6 +81,10 @@ TEST(ObjectnessUnion, FindsSmallLandmarksInCameraFrame) {
 TEST(ObjectnessUnion, SourcesAndSwitches) {
   const cv::Mat img = scene({320, 240}, {{100, 80, 80, 60}}, 3);
   ObjectnessParams p;
+  int edges = 0;
+  for (const auto& w : Objectness(p).propose(img, 1000)) edges += w.source == Window::Edges;
+  EXPECT_GT(edges, 0) << "EdgeBoxes windows are part of the default union";
+  p.use_edgeboxes = false;
   p.use_ccs = false;
   for (const auto& w : Objectness(p).propose(img, 50)) EXPECT_EQ(w.source, Window::SCS);
   p.use_ccs = true;
