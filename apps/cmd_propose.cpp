@@ -217,7 +217,7 @@ int runImage(const Args& args, GlobalOptions& g, const ObjectnessParams& params)
     printJson(j);
   } else {
     std::cout << wins.size() << " windows in " << fmt(ms, 1) << " ms; top " << draw << " drawn to "
-              << out << " (red CCS, blue SCS, green both)\n";
+              << out << " (red CCS, blue SCS, green both, orange EdgeBoxes)\n";
     for (size_t i = 0; i < std::min<size_t>(wins.size(), 10); ++i)
       std::cout << "  " << wins[i].box.x << "," << wins[i].box.y << " " << wins[i].box.width << "x"
                 << wins[i].box.height << " score " << fmt(wins[i].score) << " "
