@@ -8,7 +8,8 @@
 # Writes OUTPUT_DIR/<set>.json (the `propose --eval --json` object) and prints a table.
 # Takes ~15 min on an idle core, most of it Selective Search on raccoon (≈2.5 s per image).
 # Environment overrides (defaults = the full benchmark): METHODS, SETS, MAX_IMAGES (0 = all),
-# PART (all / first-half / second-half).
+# PART (all / first-half / second-half), OURS_SET (global options for ours, e.g.
+# "--set objectness.use_edgeboxes=true").
 set -eu
 here=$(cd "$(dirname "$0")" && pwd)
 root=$(cd "$here/../.." && pwd)
@@ -22,7 +23,7 @@ part=${PART:-all}  # all, first-half (dev) or second-half (held out)
 mkdir -p "$out"
 for set in $sets; do
   echo "== $set" >&2
-  "$bin" propose --eval "$data/$set" --methods "$methods" --windows 10,100,1000 \
+  "$bin" ${OURS_SET:-} propose --eval "$data/$set" --methods "$methods" --windows 10,100,1000 \
     --max-images "$max_images" --part "$part" --json > "$out/$set.json"
 done
 if command -v python3 >/dev/null 2>&1; then

@@ -36,17 +36,17 @@ struct Window {
 const char* toString(Window::Source s);
 
 struct ObjectnessParams {
-  int work_long_side = 200;   // px: long side of the working image (both methods)
-  bool use_ccs = true;        // run the CCS method
-  bool use_scs = true;        // run the SCS method
-  double nms_iou = 0.85;      // NMS overlap above which the lower-scored window is suppressed
-  double both_iou = 0.8;      // CCS and SCS windows this similar count as found by both
-  double ccs_bonus = 0.05;    // added to the SS score of CCS windows
-  double both_bonus = 0.05;   // added when both methods found the window
-  int min_side = 4;           // px at working resolution: smaller windows are dropped
-  bool use_edgeboxes = true;  // add EdgeBoxes (cv::ximgproc) windows on the working image's
-                              // NMS-thinned Sobel edges (baselines.h sobelEdges)
-  int edgeboxes_max = 200;    // EdgeBoxes windows added per frame
+  int work_long_side = 200;    // px: long side of the working image (both methods)
+  bool use_ccs = true;         // run the CCS method
+  bool use_scs = true;         // run the SCS method
+  double nms_iou = 0.85;       // NMS overlap above which the lower-scored window is suppressed
+  double both_iou = 0.8;       // CCS and SCS windows this similar count as found by both
+  double ccs_bonus = 0.05;     // added to the SS score of CCS windows
+  double both_bonus = 0.05;    // added when both methods found the window
+  int min_side = 4;            // px at working resolution: smaller windows are dropped
+  bool use_edgeboxes = false;  // add EdgeBoxes (cv::ximgproc) windows on the working image's
+                               // NMS-thinned Sobel edges (baselines.h sobelEdges)
+  int edgeboxes_max = 200;     // EdgeBoxes windows added per frame
   double edgeboxes_bonus =
       -0.1;  // added to the SS score of EdgeBoxes windows (< 0: segment windows rank first)
   double edgeboxes_min_area_frac = 0.01;  // EdgeBoxes' smallest box, fraction of the image
