@@ -60,14 +60,23 @@ std::unique_ptr<ProposalMethod> makeMethod(const std::string& name, const Object
     ObjectnessParams q = p;
     q.use_ccs = name == "ccs";
     q.use_scs = name == "scs";
+    q.use_edgeboxes = false;  // one method alone
     return std::make_unique<Ours>(name, q);
   }
   if (name == "bing") return makeBing(bing_dir, scratch);
-  if (name == "selective-search") return makeSelectiveSearchFast();
+  if (name == "selective-search" || name == "selective-search-as-returned" ||
+      name == "selective-search-random") {
+    static std::shared_ptr<void> run = makeSelectiveSearchRun();  // one SS run per image
+    const SsOrder order = name == "selective-search"          ? SsOrder::Reversed
+                          : name == "selective-search-random" ? SsOrder::Random
+                                                              : SsOrder::AsReturned;
+    return makeSelectiveSearchFast(order, run);
+  }
   if (name == "edgeboxes") return makeEdgeBoxesSobel();
   if (name == "sliding-window") return makeSlidingWindow();
   throw InputError("sketchnav propose: --methods: unknown method '" + name +
-                   "' (ours, ccs, scs, bing, selective-search, edgeboxes, sliding-window)");
+                   "' (ours, ccs, scs, bing, selective-search, selective-search-as-returned, "
+                   "selective-search-random, edgeboxes, sliding-window)");
 }
 
 std::string fmt(double v, int prec = 3) {
@@ -91,6 +100,17 @@ int runEval(const Args& args, GlobalOptions& g, const ObjectnessParams& params) 
   if (names.empty()) throw InputError("sketchnav propose: --methods is empty");
   const int max_images = args.getInt("max-images");
   auto images = readVocDataset(dir);
+  // --part: a fixed split for tuning on one half and reporting on the other. The images are in
+  // readVocDataset's order (ImageSets list, else ids sorted by name); first-half = the first
+  // ⌊n/2⌋ of them, second-half = the rest.
+  const std::string part = args.get("part");
+  if (part == "first-half")
+    images.resize(images.size() / 2);
+  else if (part == "second-half")
+    images.erase(images.begin(), images.begin() + static_cast<long>(images.size() / 2));
+  else if (part != "all")
+    throw InputError("sketchnav propose: --part: '" + part +
+                     "' is not one of all, first-half, second-half");
   if (max_images > 0 && static_cast<int>(images.size()) > max_images) images.resize(max_images);
   const std::string bing_dir = args.has("bing-model") && !args.get("bing-model").empty()
                                    ? args.get("bing-model")
@@ -109,9 +129,13 @@ int runEval(const Args& args, GlobalOptions& g, const ObjectnessParams& params) 
   std::error_code ec;
   fs::remove_all(scratch, ec);
 
-  Json j = {{"dataset", dir},       {"images", r.images},
-            {"objects", r.objects}, {"skipped_images", r.skipped},
-            {"windows", budgets},   {"methods", Json::object()}};
+  Json j = {{"dataset", dir},
+            {"images", r.images},
+            {"objects", r.objects},
+            {"skipped_images", r.skipped},
+            {"part", part},
+            {"windows", budgets},
+            {"methods", Json::object()}};
   j["params"] = paramsToJson(params);
   j["params"]["ccs"] = paramsToJson(params.ccs);
   j["params"]["scs"] = paramsToJson(params.scs);
@@ -173,9 +197,10 @@ int runImage(const Args& args, GlobalOptions& g, const ObjectnessParams& params)
   cv::Mat vis = img.clone();
   for (int i = std::min<int>(draw, static_cast<int>(wins.size())) - 1; i >= 0; --i) {
     const auto& w = wins[i];
-    const cv::Scalar colour = w.source == Window::CCS   ? cv::Scalar(0, 0, 255)
-                              : w.source == Window::SCS ? cv::Scalar(255, 128, 0)
-                                                        : cv::Scalar(0, 200, 0);
+    const cv::Scalar colour = w.source == Window::CCS     ? cv::Scalar(0, 0, 255)
+                              : w.source == Window::SCS   ? cv::Scalar(255, 128, 0)
+                              : w.source == Window::Edges ? cv::Scalar(0, 200, 255)
+                                                          : cv::Scalar(0, 200, 0);
     cv::rectangle(vis, w.box, colour, i < 5 ? 2 : 1);
   }
   if (!cv::imwrite(out, vis)) throw RuntimeError("sketchnav propose: cannot write " + out);
@@ -192,7 +217,7 @@ int runImage(const Args& args, GlobalOptions& g, const ObjectnessParams& params)
     printJson(j);
   } else {
     std::cout << wins.size() << " windows in " << fmt(ms, 1) << " ms; top " << draw << " drawn to "
-              << out << " (red CCS, blue SCS, green both)\n";
+              << out << " (red CCS, blue SCS, green both, orange EdgeBoxes)\n";
     for (size_t i = 0; i < std::min<size_t>(wins.size(), 10); ++i)
       std::cout << "  " << wins[i].box.x << "," << wins[i].box.y << " " << wins[i].box.width << "x"
                 << wins[i].box.height << " score " << fmt(wins[i].score) << " "
@@ -214,8 +239,13 @@ int runPropose(const std::vector<std::string>& argv0, GlobalOptions& g) {
       .option("draw", "how many of the top windows to draw", "20")
       .option("eval", "VOC-layout folder to evaluate on")
       .option("methods",
-              "comma-separated: ours, ccs, scs, bing, selective-search, edgeboxes, sliding-window",
+              "comma-separated: ours, ccs, scs, bing, selective-search (read reversed), "
+              "selective-search-as-returned, selective-search-random, edgeboxes, sliding-window",
               "ours,ccs,scs,bing,selective-search,edgeboxes,sliding-window")
+      .option("part",
+              "all, first-half or second-half of the images in list/sorted-name order "
+              "(a fixed dev / held-out split)",
+              "all")
       .option("max-images", "evaluate only the first N images (0 = all)", "0")
       .option("bing-model", "BING model folder (default: <VOCDIR>/../bing-model)");
   if (!args.parse(argv)) return 0;

@@ -12,6 +12,7 @@ set(LANDMARKS_OBJECTNESS_SOURCES
   ${CMAKE_CURRENT_SOURCE_DIR}/src/ccs_propose.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/src/objectness_propose.cpp)
 set(LANDMARKS_OBJECTNESS_TESTS
+  ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_objectness_baselines.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_objectness_boxes.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_objectness_parts.cpp
   ${CMAKE_CURRENT_SOURCE_DIR}/tests/test_objectness_union.cpp)

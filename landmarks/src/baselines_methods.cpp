@@ -78,57 +78,55 @@ class Bing : public ProposalMethod {
   cv::Ptr<cv::saliency::ObjectnessBING> bing_;
 };
 
+// One Selective Search run per image shared by the orderings: the benchmark passes the same
+// image to every method in turn, so the variants are compared on identical boxes and SS's
+// ~1–2 s per image is paid once. Keyed by the pixel buffer's address, size and a checksum.
+struct SsCache {
+  const void* data = nullptr;
+  cv::Size size;
+  double checksum = 0;
+  std::vector<cv::Rect> rects;
+};
+
+std::vector<cv::Rect> runSelectiveSearch(const cv::Mat& bgr, SsCache& cache) {
+  const double sum = cv::sum(bgr)[0] + 3.0 * cv::sum(bgr)[1] + 7.0 * cv::sum(bgr)[2];
+  if (cache.data == bgr.data && cache.size == bgr.size() && cache.checksum == sum)
+    return cache.rects;
+  auto ss = cv::ximgproc::segmentation::createSelectiveSearchSegmentation();
+  ss->setBaseImage(bgr);
+  ss->switchToSelectiveSearchFast();
+  std::vector<cv::Rect> rects;
+  ss->process(rects);
+  cache.data = bgr.data;
+  cache.size = bgr.size();
+  cache.checksum = sum;
+  cache.rects = rects;
+  return rects;
+}
+
 class SelectiveSearchFast : public ProposalMethod {
  public:
-  std::string name() const override { return "selective-search"; }
+  SelectiveSearchFast(SsOrder order, std::shared_ptr<SsCache> cache, std::string name)
+      : order_(order), cache_(std::move(cache)), name_(std::move(name)) {}
+  std::string name() const override { return name_; }
   std::vector<cv::Rect> propose(const cv::Mat& bgr, int max_windows) override {
-    auto ss = cv::ximgproc::segmentation::createSelectiveSearchSegmentation();
-    ss->setBaseImage(bgr);
-    ss->switchToSelectiveSearchFast();
-    std::vector<cv::Rect> rects;
-    ss->process(rects);
+    std::vector<cv::Rect> rects = orderSelectiveSearch(runSelectiveSearch(bgr, *cache_), order_);
     if (static_cast<int>(rects.size()) > max_windows) rects.resize(max_windows);
     return rects;
   }
+
+ private:
+  SsOrder order_;
+  std::shared_ptr<SsCache> cache_;
+  std::string name_;
 };
 
 class EdgeBoxesSobel : public ProposalMethod {
  public:
   std::string name() const override { return "edgeboxes"; }
   std::vector<cv::Rect> propose(const cv::Mat& bgr, int max_windows) override {
-    cv::Mat gray, f, gx, gy, mag, orient;
-    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
-    gray.convertTo(f, CV_32F, 1.0 / 255.0);
-    cv::GaussianBlur(f, f, cv::Size(5, 5), 1.0);
-    cv::Sobel(f, gx, CV_32F, 1, 0, 3);
-    cv::Sobel(f, gy, CV_32F, 0, 1, 3);
-    cv::magnitude(gx, gy, mag);
-    double mx = 0;
-    cv::minMaxLoc(mag, nullptr, &mx);
-    if (mx > 0) mag /= mx;
-    // Edge orientation in [0, π): the gradient direction folded, as EdgeBoxes expects.
-    orient.create(f.size(), CV_32F);
-    for (int y = 0; y < f.rows; ++y)
-      for (int x = 0; x < f.cols; ++x) {
-        float a = std::atan2(gy.at<float>(y, x), gx.at<float>(y, x));
-        if (a < 0) a += static_cast<float>(CV_PI);
-        orient.at<float>(y, x) = a;
-      }
-    // Thin the edges (non-maximum suppression across the edge, as structured edges are
-    // before EdgeBoxes) and drop the weakest responses: dense Sobel maps make EdgeBoxes both
-    // slow and blind to object contours.
-    cv::Mat thin(mag.size(), CV_32F, cv::Scalar(0));
-    for (int y = 1; y + 1 < mag.rows; ++y)
-      for (int x = 1; x + 1 < mag.cols; ++x) {
-        const float m = mag.at<float>(y, x);
-        if (m < 0.05f) continue;
-        const float a = orient.at<float>(y, x);
-        const int dx = static_cast<int>(std::lround(std::cos(a))),
-                  dy = static_cast<int>(std::lround(std::sin(a)));
-        if (m >= mag.at<float>(y + dy, x + dx) && m >= mag.at<float>(y - dy, x - dx))
-          thin.at<float>(y, x) = m;
-      }
-    mag = thin;
+    cv::Mat mag, orient;
+    sobelEdges(bgr, mag, orient);
     auto eb = cv::ximgproc::createEdgeBoxes();
     eb->setMaxBoxes(max_windows);
     std::vector<cv::Rect> boxes;
@@ -148,6 +146,70 @@ class SlidingWindow : public ProposalMethod {
 };
 
 }  // namespace
+
+std::vector<cv::Rect> orderSelectiveSearch(std::vector<cv::Rect> rects, SsOrder order) {
+  switch (order) {
+    case SsOrder::AsReturned:
+      break;
+    case SsOrder::Reversed:
+      // OpenCV sorts its regions by rank = level × U(0,1) *ascending*, where the level is 1 for
+      // the initial Felzenszwalb segments and grows with each merge: as returned, the list
+      // starts with the smallest fragments. Uijlings et al. rank the other way (the regions
+      // merged last, i.e. whole objects, first), which is what reversing restores.
+      std::reverse(rects.begin(), rects.end());
+      break;
+    case SsOrder::Random: {
+      // Hosang et al.'s "random" control: a uniform shuffle, seeded so runs repeat.
+      cv::RNG rng(0x5e1ec7);
+      for (int i = static_cast<int>(rects.size()) - 1; i > 0; --i)
+        std::swap(rects[i], rects[rng.uniform(0, i + 1)]);
+      break;
+    }
+  }
+  return rects;
+}
+
+void sobelEdges(const cv::Mat& bgr, cv::Mat& magnitude, cv::Mat& orientation) {
+  cv::Mat gray, f, gx, gy, mag, orient;
+  if (bgr.channels() == 3)
+    cv::cvtColor(bgr, gray, cv::COLOR_BGR2GRAY);
+  else
+    gray = bgr;
+  gray.convertTo(f, CV_32F, 1.0 / 255.0);
+  cv::GaussianBlur(f, f, cv::Size(5, 5), 1.0);
+  cv::Sobel(f, gx, CV_32F, 1, 0, 3);
+  cv::Sobel(f, gy, CV_32F, 0, 1, 3);
+  cv::magnitude(gx, gy, mag);
+  double mx = 0;
+  cv::minMaxLoc(mag, nullptr, &mx);
+  if (mx > 0) mag /= mx;
+  // Gradient direction in [0, 2π) folded to [0, π): EdgeBoxes wants the edge orientation mod π.
+  cv::phase(gx, gy, orient);
+  const float pi = static_cast<float>(CV_PI);
+  orient.forEach<float>([pi](float& a, const int*) {
+    if (a >= pi) a -= pi;
+    if (a >= pi) a = 0.f;
+  });
+  // Thin the edges (non-maximum suppression across the edge, as structured edges are before
+  // EdgeBoxes) and drop the weakest responses: dense Sobel maps make EdgeBoxes both slow and
+  // blind to object contours.
+  cv::Mat thin(mag.size(), CV_32F, cv::Scalar(0));
+  for (int y = 1; y + 1 < mag.rows; ++y) {
+    const float* m0 = mag.ptr<float>(y);
+    const float* o0 = orient.ptr<float>(y);
+    float* t0 = thin.ptr<float>(y);
+    for (int x = 1; x + 1 < mag.cols; ++x) {
+      const float m = m0[x];
+      if (m < 0.05f) continue;
+      const float a = o0[x];
+      const int dx = static_cast<int>(std::lround(std::cos(a))),
+                dy = static_cast<int>(std::lround(std::sin(a)));
+      if (m >= mag.at<float>(y + dy, x + dx) && m > mag.at<float>(y - dy, x - dx)) t0[x] = m;
+    }
+  }
+  magnitude = thin;
+  orientation = orient;
+}
 
 std::vector<cv::Rect> slidingWindowGrid(const cv::Size& size, int max_windows, int scales,
                                         bool dense) {
@@ -187,8 +249,17 @@ std::unique_ptr<ProposalMethod> makeBing(const std::string& model_dir,
                                          const std::string& scratch_dir) {
   return std::make_unique<Bing>(model_dir, scratch_dir);
 }
-std::unique_ptr<ProposalMethod> makeSelectiveSearchFast() {
-  return std::make_unique<SelectiveSearchFast>();
+std::unique_ptr<ProposalMethod> makeSelectiveSearchFast(SsOrder order,
+                                                        std::shared_ptr<void> shared_run) {
+  std::shared_ptr<SsCache> cache =
+      shared_run ? std::static_pointer_cast<SsCache>(shared_run) : std::make_shared<SsCache>();
+  const char* name = order == SsOrder::Reversed ? "selective-search"
+                     : order == SsOrder::Random ? "selective-search-random"
+                                                : "selective-search-as-returned";
+  return std::make_unique<SelectiveSearchFast>(order, cache, name);
+}
+std::shared_ptr<void> makeSelectiveSearchRun() {
+  return std::make_shared<SsCache>();
 }
 std::unique_ptr<ProposalMethod> makeEdgeBoxesSobel() {
   return std::make_unique<EdgeBoxesSobel>();

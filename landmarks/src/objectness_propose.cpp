@@ -1,9 +1,11 @@
 // The union of CCS and SCS windows (objectness.h).
 #include <opencv2/imgproc.hpp>
+#include <opencv2/ximgproc.hpp>
 
 #include <algorithm>
 #include <cmath>
 
+#include "sketchnav/landmarks/baselines.h"
 #include "sketchnav/landmarks/objectness.h"
 
 namespace sketchnav::landmarks {
@@ -16,6 +18,8 @@ const char* toString(Window::Source s) {
       return "scs";
     case Window::Both:
       return "both";
+    case Window::Edges:
+      return "edges";
   }
   return "?";
 }
@@ -27,6 +31,14 @@ void ObjectnessParams::validate() const {
   require(nms_iou > 0 && nms_iou <= 1, "objectness.nms_iou", "must be in (0, 1]");
   require(both_iou > 0 && both_iou <= 1, "objectness.both_iou", "must be in (0, 1]");
   require(min_side >= 1, "objectness.min_side", "must be >= 1 px");
+  require(edgeboxes_max >= 1 && edgeboxes_max <= 100000, "objectness.edgeboxes_max",
+          "must be in [1, 100000]");
+  require(edgeboxes_min_area_frac >= 0 && edgeboxes_min_area_frac < 1,
+          "objectness.edgeboxes_min_area_frac", "must be in [0, 1)");
+  require(edgeboxes_alpha > 0 && edgeboxes_alpha < 1, "objectness.edgeboxes_alpha",
+          "must be in (0, 1)");
+  require(edgeboxes_long_side >= 16 && edgeboxes_long_side <= 2048,
+          "objectness.edgeboxes_long_side", "must be in [16, 2048] px");
   ccs.validate();
   scs.validate();
 }
@@ -114,6 +126,34 @@ std::vector<Window> Objectness::propose(const cv::Mat& input, int max_windows) c
           src[i] = Window::Both;
           break;
         }
+    }
+  }
+  if (p.use_edgeboxes) {
+    // EdgeBoxes' cost grows with the pixel count and the candidate count: it may run on a
+    // smaller copy of the working image; its boxes are scaled back to working pixels.
+    const double es =
+        std::min(1.0, static_cast<double>(p.edgeboxes_long_side) / std::max(bgr.cols, bgr.rows));
+    cv::Mat small;
+    if (es < 1.0)
+      cv::resize(bgr, small, cv::Size(), es, es, cv::INTER_AREA);
+    else
+      small = bgr;
+    cv::Mat mag, orient;
+    sobelEdges(small, mag, orient);
+    auto eb = cv::ximgproc::createEdgeBoxes(static_cast<float>(p.edgeboxes_alpha));
+    eb->setMaxBoxes(p.edgeboxes_max);
+    eb->setMinBoxArea(static_cast<float>(p.edgeboxes_min_area_frac * small.cols * small.rows));
+    std::vector<cv::Rect> eboxes;
+    std::vector<float> escores;
+    eb->getBoundingBoxes(mag, orient, eboxes, escores);
+    const cv::Rect frame(0, 0, bgr.cols, bgr.rows);
+    for (const auto& r : eboxes) {
+      const cv::Rect c = cv::Rect(cvRound(r.x / es), cvRound(r.y / es), cvRound(r.width / es),
+                                  cvRound(r.height / es)) &
+                         frame;
+      if (c.area() <= 0) continue;
+      boxes.push_back({c, static_cast<float>(scorer.score(c) + p.edgeboxes_bonus)});
+      src.push_back(Window::Edges);
     }
   }
   // Drop windows too small to be useful at the working resolution.

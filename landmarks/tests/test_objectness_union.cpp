@@ -72,15 +72,23 @@ TEST(ObjectnessUnion, FindsSmallLandmarksInCameraFrame) {
   // A 640x480 frame of a plain room with three photo-like landmarks 40–120 px wide.
   const std::vector<cv::Rect> objs = {{80, 200, 40, 50}, {300, 150, 120, 90}, {520, 260, 60, 60}};
   const cv::Mat img = scene({640, 480}, objs, 2);
-  const Objectness o{ObjectnessParams{}};
-  const auto w = o.propose(img, 100);
-  expectSane(w, img.size(), 100);
-  for (const auto& g : objs) EXPECT_GE(best(w, g, 100), 0.6) << g;
+  for (const bool eb : {false, true}) {
+    ObjectnessParams p;
+    p.use_edgeboxes = eb;
+    const auto w = Objectness{p}.propose(img, 100);
+    expectSane(w, img.size(), 100);
+    for (const auto& g : objs) EXPECT_GE(best(w, g, 100), 0.6) << g << " edgeboxes " << eb;
+  }
 }
 
 TEST(ObjectnessUnion, SourcesAndSwitches) {
   const cv::Mat img = scene({320, 240}, {{100, 80, 80, 60}}, 3);
   ObjectnessParams p;
+  p.use_edgeboxes = true;
+  int edges = 0;
+  for (const auto& w : Objectness(p).propose(img, 1000)) edges += w.source == Window::Edges;
+  EXPECT_GT(edges, 0) << "use_edgeboxes adds EdgeBoxes windows to the union";
+  p.use_edgeboxes = false;
   p.use_ccs = false;
   for (const auto& w : Objectness(p).propose(img, 50)) EXPECT_EQ(w.source, Window::SCS);
   p.use_ccs = true;

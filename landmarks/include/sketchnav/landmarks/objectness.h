@@ -27,7 +27,7 @@ namespace sketchnav::landmarks {
 
 /// One candidate window, in the input image's pixel coordinates.
 struct Window {
-  enum Source { CCS, SCS, Both };
+  enum Source { CCS, SCS, Both, Edges };  // Edges: EdgeBoxes on the working image's edges
   cv::Rect box;
   float score = 0.f;  // higher = more object-like; comparable across sources
   Source source = SCS;
@@ -36,14 +36,23 @@ struct Window {
 const char* toString(Window::Source s);
 
 struct ObjectnessParams {
-  int work_long_side = 200;  // px: long side of the working image (both methods)
-  bool use_ccs = true;       // run the CCS method
-  bool use_scs = true;       // run the SCS method
-  double nms_iou = 0.85;     // NMS overlap above which the lower-scored window is suppressed
-  double both_iou = 0.8;     // CCS and SCS windows this similar count as found by both
-  double ccs_bonus = 0.05;   // added to the SS score of CCS windows
-  double both_bonus = 0.05;  // added when both methods found the window
-  int min_side = 4;          // px at working resolution: smaller windows are dropped
+  int work_long_side = 200;    // px: long side of the working image (both methods)
+  bool use_ccs = true;         // run the CCS method
+  bool use_scs = true;         // run the SCS method
+  double nms_iou = 0.85;       // NMS overlap above which the lower-scored window is suppressed
+  double both_iou = 0.8;       // CCS and SCS windows this similar count as found by both
+  double ccs_bonus = 0.05;     // added to the SS score of CCS windows
+  double both_bonus = 0.05;    // added when both methods found the window
+  int min_side = 4;            // px at working resolution: smaller windows are dropped
+  bool use_edgeboxes = false;  // add EdgeBoxes (cv::ximgproc) windows on the working image's
+                               // NMS-thinned Sobel edges (baselines.h sobelEdges)
+  int edgeboxes_max = 200;     // EdgeBoxes windows added per frame
+  double edgeboxes_bonus =
+      -0.1;  // added to the SS score of EdgeBoxes windows (< 0: segment windows rank first)
+  double edgeboxes_min_area_frac = 0.01;  // EdgeBoxes' smallest box, fraction of the image
+  double edgeboxes_alpha = 0.55;  // EdgeBoxes' search step (IoU of neighbouring candidates);
+                                  // lower = coarser and faster
+  int edgeboxes_long_side = 120;  // px: EdgeBoxes runs on the working image shrunk to this
   CcsParams ccs;
   ScsParams scs;
 
@@ -57,6 +66,12 @@ struct ObjectnessParams {
     b("ccs_bonus", ccs_bonus);
     b("both_bonus", both_bonus);
     b("min_side", min_side);
+    b("use_edgeboxes", use_edgeboxes);
+    b("edgeboxes_max", edgeboxes_max);
+    b("edgeboxes_bonus", edgeboxes_bonus);
+    b("edgeboxes_min_area_frac", edgeboxes_min_area_frac);
+    b("edgeboxes_alpha", edgeboxes_alpha);
+    b("edgeboxes_long_side", edgeboxes_long_side);
   }
   /// Checks these fields and the nested ccs / scs params; throws InputError naming the field.
   void validate() const;
