@@ -56,8 +56,11 @@ class MatchFixture : public ::testing::Test {
     std::vector<cv::Point2f> proj;
     cv::perspectiveTransform(m.x_d, proj, H);
     for (size_t i = 0; i < proj.size(); ++i) EXPECT_LT(cv::norm(proj[i] - m.x_t[i]), 8.0);
-    // The servo offset: the object's centre column in the frame.
-    std::vector<cv::Point2f> c = {{160, 120}}, cf;
+    // The servo offset: the column of the matched part's centre in the frame (the centre of
+    // the inliers' extent in the photo through the true warp; here the object fills the photo).
+    const cv::Rect2f part = cv::boundingRect(m.x_d);
+    std::vector<cv::Point2f> c = {{part.x + 0.5f * part.width, part.y + 0.5f * part.height}}, cf;
+    EXPECT_LT(cv::norm(c[0] - cv::Point2f(160, 120)), 20.0);
     cv::perspectiveTransform(c, cf, H);
     const ServoOffset o = servoOffset(m, 640);
     ASSERT_TRUE(o.valid);
@@ -301,4 +304,33 @@ TEST(RansacIterations, BoundedRansacStillFindsAPlantedModelOfMinInliers) {
     found += planted == m ? 1 : 0;
   }
   EXPECT_GE(found, trials * 97 / 100);
+}
+
+// A photo that frames its object off-centre (here the left half; the right half is plain): the
+// servo's column is the object's, not the photo centre's, which lies 80 photo px to its right.
+TEST(ServoOffsetFraming, TheObjectsColumnNotThePhotosCentre) {
+  const std::string root = test::tempDir("recog-framing");
+  std::filesystem::create_directories(root + "/held");
+  std::filesystem::create_directories(root + "/other");
+  cv::Mat photo(240, 320, CV_8UC3, cv::Scalar(128, 128, 128));
+  test::texturedImage(160, 240, 2000).copyTo(photo(cv::Rect(0, 0, 160, 240)));
+  cv::imwrite(root + "/held/photo.png", photo);
+  cv::imwrite(root + "/other/photo.png", test::texturedImage(320, 240, 2001));
+  ModelParams p;
+  p.vocabulary_size = 50;
+  const LandmarkModel model = trainModel(root, p);
+  // The photo at 1.2x, its left edge at column 150, in a 640 x 480 frame.
+  const cv::Mat H = (cv::Mat_<double>(3, 3) << 1.2, 0, 150, 0, 1.2, 100, 0, 0, 1);
+  cv::Mat frame(480, 640, CV_8UC3);
+  cv::RNG(5).fill(frame, cv::RNG::UNIFORM, 90, 160);
+  cv::GaussianBlur(frame, frame, cv::Size(0, 0), 4);
+  cv::warpPerspective(photo, frame, H, frame.size(), cv::INTER_LINEAR, cv::BORDER_TRANSPARENT);
+  const MatchResult m = match(model, frame, cv::Rect(), "held", MatchParams{});
+  ASSERT_TRUE(m.matched);
+  const ServoOffset o = servoOffset(m, 640);
+  ASSERT_TRUE(o.valid);
+  const double object_u = 150 + 1.2 * 80, photo_centre_u = 150 + 1.2 * 160;
+  EXPECT_NEAR(o.object_u, object_u, 12.0);
+  EXPECT_GT(std::abs(o.object_u - photo_centre_u), 80.0);
+  EXPECT_NEAR(o.centre_u, photo_centre_u, 4.0);  // elevations still read at the photo centre
 }
