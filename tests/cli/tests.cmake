@@ -26,3 +26,15 @@ add_test(NAME cli_recognise_pictures
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-recognise-pictures
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/recognise_outputs.cmake)
 set_tests_properties(cli_recognise_pictures PROPERTIES TIMEOUT 600)
+# Strict settings: unknown keys are exit 2 with the closest known key, on every subcommand.
+add_test(NAME cli_settings_strict
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DSRC=${PROJECT_SOURCE_DIR}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings.cmake)
+set_tests_properties(cli_settings_strict PROPERTIES TIMEOUT 300)
+# A short simulated run repeated from its summary's settings as --config: same settings,
+# same outcome, same telemetry.
+add_test(NAME cli_settings_roundtrip
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings-roundtrip
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings_roundtrip.cmake)
+set_tests_properties(cli_settings_roundtrip PROPERTIES TIMEOUT 600)
