@@ -33,7 +33,7 @@ add_test(NAME cli_settings_strict
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings.cmake)
 set_tests_properties(cli_settings_strict PROPERTIES TIMEOUT 300)
 # A short simulated run repeated from its summary's settings as --config: same settings,
-# same outcome, same telemetry.
+# same outcome.
 add_test(NAME cli_settings_roundtrip
   COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings-roundtrip
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings_roundtrip.cmake)
