@@ -52,6 +52,11 @@ int runBaseEmulator(const std::vector<std::string>& argv, GlobalOptions& g) {
 
   hw::BaseServerParams p;
   applyConfig(p, g.config, "base_server");
+  {
+    sim::SimParams sp;  // --world none takes them too (and ignores them), as before
+    applyConfig(sp, g.config, "sim");
+  }
+  g.config.requireAllUsed();
   p.port = args.getInt("port");
   p.bind_host = args.get("bind");
   p.allowed_peer = args.get("laptop");

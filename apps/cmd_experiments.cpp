@@ -142,6 +142,9 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
   std::vector<Variant> variants;
   for (const auto& n : names) variants.push_back(makeVariant(n));  // InputError on unknown
   const SketchNoise noise = sketchNoiseFrom(g.config);
+  // The trials' settings (every run setting; the trials apply them again): a typo fails here.
+  runSettingsFrom(g.config);
+  g.config.requireAllUsedExcept(driverSettingPrefixes());
 
   const std::string out = makeOutputDir(args.get("out"));
   const std::string model = ensureModel(args.get("model"), true);

@@ -68,6 +68,8 @@ int runProbe(const std::vector<std::string>& argv, GlobalOptions& g) {
     throw InputError("sketchnav probe: --kind must be camera, base or range, got '" + kind + "'");
   auto enough = [&](std::uint64_t n) { return by_frames && static_cast<long>(n) >= max_frames; };
 
+  // The device's driver settings are applied when it is opened (checked below); no other.
+  g.config.requireAllUsedExcept({"base.", "camera.", "laser.", "sonar.", "sim."});
   hw::DeviceContext ctx;
   ctx.config = g.config;
   hw::SteadyClock wall;

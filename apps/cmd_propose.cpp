@@ -250,6 +250,7 @@ int runPropose(const std::vector<std::string>& argv0, GlobalOptions& g) {
       .option("bing-model", "BING model folder (default: <VOCDIR>/../bing-model)");
   if (!args.parse(argv)) return 0;
   ObjectnessParams params = objectnessParamsFrom(g.config);
+  g.config.requireAllUsed();
   const bool eval = args.has("eval") && !args.get("eval").empty();
   if (eval == !args.positional().empty())
     throw InputError("sketchnav propose: give either IMAGE or --eval VOCDIR");

@@ -399,8 +399,9 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
       throw InputError("sketchnav recognise: --frame expects WxH, e.g. 640x480");
     runner.frame_size = cv::Size(w, h);
   }
-  if (runner.windows > 0)
-    runner.objectness = std::make_unique<lm::Objectness>(lm::objectnessParamsFrom(g.config));
+  const lm::ObjectnessParams objectness = lm::objectnessParamsFrom(g.config);
+  g.config.requireAllUsed();
+  if (runner.windows > 0) runner.objectness = std::make_unique<lm::Objectness>(objectness);
 
   std::ofstream details;
   if (!args.get("details").empty()) {

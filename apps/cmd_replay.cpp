@@ -447,15 +447,19 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     for (const auto& c : cls) known += (known.empty() ? "" : ", ") + c;
     throw InputError("--target " + target + ": not a class of the model (" + known + ")");
   }
-  FrameSource source(args.get("frames"), hfov, g.config);
-  const std::string out = makeOutputDir(args.get("out"));
-
   nav::PerceptionParams pp;
   applyConfig(pp, g.config, "nav.perception");
+  applyConfig(pp.recognition, g.config, "landmarks.recognition");
+  pp.objectness = landmarks::objectnessParamsFrom(g.config);
   pp.validate();
   servo::TurnLawParams tp;
   applyConfig(tp, g.config, "servo");
   tp.validate();
+  // A camera URI's driver settings (sim.*, camera.*) are applied when it is opened.
+  g.config.requireAllUsedExcept({"sim.", "camera."});
+  FrameSource source(args.get("frames"), hfov, g.config);
+  g.config.requireAllUsed();
+  const std::string out = makeOutputDir(args.get("out"));
   nav::LandmarkPerception perception(model, pp);
   servo::TurnLaw law(tp);
 

@@ -149,6 +149,7 @@ int runRoute(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   if (!args.parse(argv)) return 0;
   RouteParams params;
   applyConfig(params, g.config, "route");
+  g.config.requireAllUsed();
   const std::string file = args.positional().front();
   const Sketch s = loadSketch(file);
   if (args.has("landmarks")) validateClasses(s, landmarkClasses(args.get("landmarks")), file);

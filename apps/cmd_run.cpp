@@ -22,7 +22,7 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
               "first use and cached")
       .option("landmarks", "landmark set folder to train the model from (default: share/landmarks)")
       .option("cache-dir", "where trained models are cached (default: ~/.cache/sketchnav)")
-      .option("seed", "simulator seed (noise, odometry errors)", "1")
+      .option("seed", "simulator seed (noise, odometry errors; default: sim.seed, else 1)")
       .flag("realtime", "simulate at wall-clock pace (default: as fast as the CPU allows)")
       .option("max-time", "give up after this many seconds of run time (default: nav.max_time_s)")
       .option("out", "output folder (default: runs/<UTC timestamp>)")
@@ -39,7 +39,16 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   o.model = args.get("model");
   o.landmark_dir = args.get("landmarks");
   o.cache_dir = args.get("cache-dir");
-  o.seed = args.getInt("seed");
+  // --seed, else the setting sim.seed (so a run's summary settings as --config repeat its seed).
+  if (!args.get("seed").empty())
+    o.seed = args.getInt("seed");
+  else if (g.config.has("sim.seed")) {
+    const Json& v = g.config.at("sim.seed");
+    if (!v.is_number_integer() || v.get<long long>() < 0 || v.get<long long>() > 2147483647)
+      throw InputError(g.config.origin("sim.seed") +
+                       ": setting 'sim.seed' must be an integer in [0, 2^31)");
+    o.seed = v.get<int>();
+  }
   o.realtime = args.flagSet("realtime");
   if (!args.get("max-time").empty()) o.max_time_s = args.getDouble("max-time");
   o.robot = args.get("robot");

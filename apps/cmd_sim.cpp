@@ -264,6 +264,9 @@ int runSim(const std::vector<std::string>& argv, GlobalOptions& g) {
     return argv.empty() ? 2 : 0;
   }
   const std::vector<std::string> rest(argv.begin() + 1, argv.end());
+  // The simulator's settings are the only ones sim takes: a typo fails before any work.
+  simParams(g);
+  g.config.requireAllUsed();
   if (argv[0] == "render") return runRender(rest, g);
   if (argv[0] == "drive") return runDrive(rest, g);
   if (argv[0] == "map") return runMap(rest, g);

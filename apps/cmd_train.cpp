@@ -34,6 +34,7 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
 
   landmarks::ModelParams p;
   applyConfig(p, g.config, "landmarks.train");
+  g.config.requireAllUsed();
   if (!args.get("vocabulary").empty()) p.vocabulary_size = args.getInt("vocabulary");
   if (!args.get("max-features").empty()) p.features.max_features = args.getInt("max-features");
   if (!args.get("seed").empty()) p.seed = args.getInt("seed");

@@ -15,6 +15,7 @@
 #include "cli.h"
 #include "exp_variants.h"
 #include "plot.h"
+#include "run_harness.h"
 #include "scenario.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
@@ -139,6 +140,7 @@ int runOffline(const std::vector<std::string>& files, const std::vector<double>&
   if (errors.empty()) throw InputError("--offline: no frame with a detection in the given CSVs");
   servo::TurnLawParams base;
   applyConfig(base, g.config, "servo");
+  g.config.requireAllUsed();
   Json rows = Json::array();
   std::printf("%-8s %8s %10s %10s %12s %10s\n", "lambda", "frames", "mean|w|", "saturated",
               "w sign chg", "agreement");
@@ -220,6 +222,16 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
   std::vector<Variant> scen;
   for (const auto& n : args.getList("scenarios")) scen.push_back(makeVariant(n));
   const SketchNoise noise = sketchNoiseFrom(g.config);
+  // The runs' settings (every run setting; the runs apply them again): a typo fails here, and
+  // --param must name one of them.
+  runSettingsFrom(g.config);
+  g.config.requireAllUsedExcept(driverSettingPrefixes());
+  {
+    const auto known = g.config.knownKeys();
+    if (std::find(known.begin(), known.end(), param) == known.end())
+      throw InputError("--param: unknown setting '" + param + "' (did you mean '" +
+                       closestKey(param, known) + "'?)");
+  }
   const std::string out = makeOutputDir(args.get("out"));
   const std::string model = ensureModel(args.get("model"), true);
   const std::string config_file = writeBatchConfig(g.config, out);

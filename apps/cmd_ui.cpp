@@ -240,6 +240,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("port", "TCP port (0 = any free port)", "8080")
       .option("allow-host", "extra Host name to accept, e.g. robot.local (with --host 0.0.0.0)");
   if (!args.parse(argv)) return 0;
+  g.config.requireAllUsed();  // the UI takes no settings (its runs use the page's)
   const int port = args.getInt("port");
   if (port < 0 || port > 65535) throw InputError("sketchnav ui: --port must be in 0..65535");
 

@@ -348,7 +348,11 @@ std::string summariseFailures(const std::vector<std::string>& reasons) {
 }
 
 std::string writeBatchConfig(const Config& config, const std::string& out) {
-  const Json j = config.toJson();
+  // The runs' settings: every key but the batch's own ("experiments.*").
+  Config runs;
+  for (const auto& k : config.keys())
+    if (k.rfind("experiments.", 0) != 0) runs.set(k, config.at(k));
+  const Json j = runs.toJson();
   if (j.empty()) return "";
   const std::string path = out + "/config.json";
   std::ofstream(path) << j.dump(2) << "\n";

@@ -85,7 +85,11 @@ int main(int argc, char** argv) {
     auto it = app::commands().find(sub);
     if (it == app::commands().end())
       throw InputError("unknown subcommand '" + sub + "' (see sketchnav --help)");
-    return it->second.run(rest, g);
+    const int rc = it->second.run(rest, g);
+    // Each subcommand applies every setting it uses and checks none is left before its work;
+    // this is the backstop for one that does not: a setting nothing read is never accepted.
+    g.config.requireAllUsed();
+    return rc;
   } catch (const InputError& e) {
     std::cerr << "sketchnav: error: " << e.what() << "\n";
     return 2;

@@ -319,6 +319,49 @@ std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Rou
   return (odomToWorld(w.start, *g) - w.goal.centre).norm();
 }
 
+RunSettings runSettingsFrom(const Config& c) {
+  RunSettings r;
+  applyConfig(r.route, c, "route");
+  applyConfig(r.train, c, "landmarks.train");
+  r.nav = nav::navSettingsFrom(c);
+  applyConfig(r.perception, c, "nav.perception");
+  applyConfig(r.perception.recognition, c, "landmarks.recognition");
+  r.perception.objectness = landmarks::objectnessParamsFrom(c);
+  applyConfig(r.sim, c, "sim");
+  return r;
+}
+
+Json runSettingsJson(const RunSettings& r, bool with_sim) {
+  Json j = Json::object();
+  j["route"] = paramsToJson(r.route);
+  j["landmarks"]["train"] = paramsToJson(r.train);
+  j["landmarks"]["recognition"] = paramsToJson(r.perception.recognition);
+  Json n = paramsToJson(r.nav.exec);
+  n["sections"] = paramsToJson(r.nav.sections);
+  n["select"] = paramsToJson(r.nav.select);
+  n["locate"] = paramsToJson(r.nav.locate);
+  n["avoid"] = paramsToJson(r.nav.avoid);
+  n["safety"] = paramsToJson(r.nav.safety);
+  n["laser_odometry"] = paramsToJson(r.nav.laser_odometry);
+  n["planner"] = paramsToJson(r.nav.planner);
+  n["movers"] = paramsToJson(r.nav.movers);
+  n["goal_door"] = paramsToJson(r.nav.goal_door);
+  n["perception"] = paramsToJson(r.perception);
+  j["nav"] = n;
+  j["servo"] = paramsToJson(r.nav.servo);
+  Json ob = paramsToJson(r.perception.objectness);
+  ob["ccs"] = paramsToJson(r.perception.objectness.ccs);
+  ob["scs"] = paramsToJson(r.perception.objectness.scs);
+  j["objectness"] = ob;
+  if (with_sim) j["sim"] = paramsToJson(r.sim);
+  return j;
+}
+
+const std::vector<std::string>& driverSettingPrefixes() {
+  static const std::vector<std::string> p = {"base.", "camera.", "laser.", "sonar."};
+  return p;
+}
+
 Json runNavigation(const RunOptions& o) {
   using wall = std::chrono::steady_clock;
   hw::registerBuiltinDrivers();
@@ -330,6 +373,10 @@ Json runNavigation(const RunOptions& o) {
   const bool hardware =
       replay || !o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty();
   if (o.seed < 0) throw InputError("--seed must be >= 0");
+  // Every setting first: a typo fails here, before a device is opened or a model trained.
+  // Device drivers' settings are checked once the devices are open.
+  RunSettings rs = runSettingsFrom(o.config);
+  o.config.requireAllUsedExcept(driverSettingPrefixes());
   hw::DeviceContext ctx;
   ctx.config = o.config;
   if (o.realtime) ctx.config.set("sim.realtime", true);
@@ -384,6 +431,7 @@ Json runNavigation(const RunOptions& o) {
   if (o.wrap_camera && camera) camera = o.wrap_camera(std::move(camera));
   if (o.wrap_base && base) base = o.wrap_base(std::move(base));
   if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
+  o.config.requireAllUsed();
   if (!o.record.empty()) {
     auto rec = std::make_shared<hw::RawlogRecorder>(o.record);
     camera = hw::recordCamera(std::move(camera), rec);
@@ -407,14 +455,11 @@ Json runNavigation(const RunOptions& o) {
     }
   }
   const mapsketch::Sketch sketch = mapsketch::loadSketch(sketch_path);
-  mapsketch::RouteParams rp;
-  applyConfig(rp, o.config, "route");
-  const mapsketch::Route route = mapsketch::toRoute(sketch, rp);
+  const mapsketch::Route route = mapsketch::toRoute(sketch, rs.route);
 
   // --- landmark model -------------------------------------------------------------------------
   std::string model_path = o.model;
-  landmarks::ModelParams mp;
-  applyConfig(mp, o.config, "landmarks.train");
+  const landmarks::ModelParams& mp = rs.train;
   auto model = std::make_shared<landmarks::LandmarkModel>();
   if (!model_path.empty()) {
     *model = landmarks::LandmarkModel::load(model_path);
@@ -443,13 +488,14 @@ Json runNavigation(const RunOptions& o) {
       log::warn("run",
                 "the world shows the model one of its training photos: this run tests the "
                 "model on its own training data, not as a real camera would",
-                {{"texture", t.texture}, {"training_photo", t.photo},
+                {{"texture", t.texture},
+                 {"training_photo", t.photo},
                  {"hash_distance_bits", std::to_string(t.distance)}});
   }
 
   // --- settings -----------------------------------------------------------------------------
-  nav::NavSettings settings = nav::navSettingsFrom(o.config);
-  nav::PerceptionParams pp;
+  nav::NavSettings& settings = rs.nav;
+  nav::PerceptionParams& pp = rs.perception;
   if (simr) {
     // The simulated robot's geometry, unless the user overrides it.
     const auto& w = simr->world();
@@ -458,15 +504,14 @@ Json runNavigation(const RunOptions& o) {
     if (!o.config.has("nav.avoid.robot_radius_m")) settings.avoid.robot_radius_m = w.robot.radius;
     if (!o.config.has("nav.camera_period_s") && simr->params().camera_hz > 0)
       settings.exec.camera_period_s = 1.0 / simr->params().camera_hz;
-    pp.camera_yaw = w.camera.yaw;
-    pp.camera_pitch = w.camera.pitch;
+    if (!o.config.has("nav.perception.camera_yaw")) pp.camera_yaw = w.camera.yaw;
+    if (!o.config.has("nav.perception.camera_pitch")) pp.camera_pitch = w.camera.pitch;
   }
   if (o.max_time_s > 0) settings.exec.max_time_s = o.max_time_s;
   settings.exec.validate();
   settings.servo.validate();
   settings.avoid.validate();
-  applyConfig(pp, o.config, "nav.perception");
-  applyConfig(pp.recognition, o.config, "landmarks.recognition");
+  pp.validate();
 
   if (!o.out_dir.empty()) fs::create_directories(o.out_dir);
   RunObserver observer(o.out_dir, o.progress, simr.get(), static_cast<int>(route.sections.size()));
@@ -522,7 +567,8 @@ Json runNavigation(const RunOptions& o) {
   s["model"] = model_path;
   Json tt = Json::array();
   for (const auto& t : training_textures)
-    tt.push_back({{"texture", t.texture}, {"training_photo", t.photo}, {"distance_bits", t.distance}});
+    tt.push_back(
+        {{"texture", t.texture}, {"training_photo", t.photo}, {"distance_bits", t.distance}});
   s["training_textures"] = tt;
   Json recognised = Json::array();
   for (const auto& l : es.landmarks)
@@ -544,13 +590,10 @@ Json runNavigation(const RunOptions& o) {
                      {"features_ms", es.features_ms_mean},
                      {"match_ms", es.match_ms_mean}};
   s["executive"] = {{"status", nav::toString(es.status)}, {"reason", es.reason}};
-  s["settings"] = {{"nav", paramsToJson(settings.exec)},
-                   {"servo", paramsToJson(settings.servo)},
-                   {"avoid", paramsToJson(settings.avoid)},
-                   {"safety", paramsToJson(settings.safety)},
-                   {"sections", paramsToJson(settings.sections)},
-                   {"laser_odometry", paramsToJson(settings.laser_odometry)},
-                   {"perception", paramsToJson(pp)}};
+  // Every setting the run used, as --config takes them (the simulator's as it ran: its seed is
+  // the run's --seed).
+  if (simr) rs.sim = simr->params();
+  s["settings"] = runSettingsJson(rs, simr != nullptr);
   s["min_clearance_m"] = nullptr;
   s["deviation_m"] = nullptr;
 

@@ -10,8 +10,11 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
+#include "sketchnav/landmarks/model.h"
+#include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/perception.h"
+#include "sketchnav/sim/simulator.h"
 
 namespace sketchnav::sim {
 struct World;
@@ -52,6 +55,24 @@ struct RunOptions {
   /// (failed, reason "stopped by user").
   std::function<bool()> stop_requested;
 };
+
+/// Every setting a run uses, over the defaults, validated. Device drivers' settings
+/// ("base.dani.*", "camera.aravis.*", "camera.folder.*") are applied when the device is opened.
+struct RunSettings {
+  mapsketch::RouteParams route;      // "route.*"
+  landmarks::ModelParams train;      // "landmarks.train.*" (when the model is trained)
+  nav::NavSettings nav;              // "nav.*" (with its sections) and "servo.*"
+  nav::PerceptionParams perception;  // "nav.perception.*", "landmarks.recognition.*",
+                                     // "objectness.*" (with .ccs, .scs)
+  sim::SimParams sim;                // "sim.*" (simulated runs)
+};
+/// Reads every run setting from `config` (marking each key used); InputError on a bad value.
+RunSettings runSettingsFrom(const Config& config);
+/// The settings as a nested JSON object in exactly the --config format (summary.json's
+/// "settings"): `sketchnav run --config` on it repeats them. `with_sim` false leaves "sim" out.
+Json runSettingsJson(const RunSettings& settings, bool with_sim = true);
+/// The prefixes of device drivers' settings, applied only when a device is opened.
+const std::vector<std::string>& driverSettingPrefixes();
 
 /// Runs one navigation. Returns the summary object (what summary.json holds). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.

@@ -2,7 +2,9 @@
 
 #include "sketchnav/core/json_io.h"
 
+#include <algorithm>
 #include <fstream>
+#include <limits>
 #include <sstream>
 
 namespace sketchnav {
@@ -67,20 +69,70 @@ std::vector<std::string> Config::keys(const std::string& prefix) const {
 }
 
 void Config::markUsed(const std::string& key) const {
-  used_.insert(key);
+  usage_->used.insert(key);
+  usage_->known.insert(key);
+}
+
+void Config::markKnown(const std::string& key) const {
+  usage_->known.insert(key);
 }
 
 std::vector<std::string> Config::unusedKeys(const std::string& prefix) const {
   std::vector<std::string> out;
   for (const auto& k : keys(prefix))
-    if (!used_.count(k)) out.push_back(k);
+    if (!usage_->used.count(k)) out.push_back(k);
   return out;
+}
+
+std::vector<std::string> Config::knownKeys() const {
+  return {usage_->known.begin(), usage_->known.end()};
+}
+
+std::string Config::unknownSettingMessage(const std::string& key) const {
+  std::string msg = origin(key) + ": unknown setting '" + key + "'";
+  const std::string best = closestKey(key, knownKeys());
+  if (!best.empty())
+    msg += " (did you mean '" + best + "'?)";
+  else
+    msg += " (this command takes no settings)";
+  return msg;
 }
 
 void Config::requireAllUsed(const std::string& prefix) const {
   const auto unused = unusedKeys(prefix);
-  if (!unused.empty())
-    throw InputError(origin(unused.front()) + ": unknown setting '" + unused.front() + "'");
+  if (!unused.empty()) throw InputError(unknownSettingMessage(unused.front()));
+}
+
+void Config::requireAllUsedExcept(const std::vector<std::string>& deferred) const {
+  for (const auto& k : unusedKeys()) {
+    bool later = false;
+    for (const auto& p : deferred) later = later || k.rfind(p, 0) == 0;
+    if (!later) throw InputError(unknownSettingMessage(k));
+  }
+}
+
+std::string closestKey(const std::string& key, const std::vector<std::string>& candidates) {
+  std::string best;
+  size_t best_d = std::numeric_limits<size_t>::max();
+  std::vector<size_t> prev, cur;
+  for (const auto& c : candidates) {
+    // Levenshtein distance, two rows.
+    prev.resize(c.size() + 1);
+    cur.resize(c.size() + 1);
+    for (size_t j = 0; j <= c.size(); ++j) prev[j] = j;
+    for (size_t i = 1; i <= key.size(); ++i) {
+      cur[0] = i;
+      for (size_t j = 1; j <= c.size(); ++j)
+        cur[j] =
+            std::min({prev[j] + 1, cur[j - 1] + 1, prev[j - 1] + (key[i - 1] == c[j - 1] ? 0 : 1)});
+      std::swap(prev, cur);
+    }
+    if (prev[c.size()] < best_d) {
+      best_d = prev[c.size()];
+      best = c;
+    }
+  }
+  return best;
 }
 
 const std::string& Config::origin(const std::string& key) const {

@@ -124,3 +124,71 @@ TEST(Config, ParamsToJsonRoundTrips) {
   applyConfig(q, c, "demo");
   EXPECT_DOUBLE_EQ(q.lambda, 1.5);
 }
+
+TEST(Config, UnknownSettingNamesTheClosestKnownKey) {
+  Config c;
+  c.set("demo.lamda=0.3");  // typo
+  DemoParams p;
+  applyConfig(p, c, "demo");
+  EXPECT_DOUBLE_EQ(p.lambda, 0.5);  // the typo changed nothing
+  try {
+    c.requireAllUsed();
+    FAIL() << "a typo was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "--set demo.lamda: unknown setting 'demo.lamda' (did you mean 'demo.lambda'?)");
+  }
+}
+
+TEST(Config, UnknownSettingFromAFileNamesTheFile) {
+  Config c = Config::fromJson(Json{{"demo", {{"window_cont", 3}}}}, "my.json");
+  DemoParams p;
+  applyConfig(p, c, "demo");
+  try {
+    c.requireAllUsed();
+    FAIL() << "a typo was accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              "my.json: unknown setting 'demo.window_cont' (did you mean 'demo.window_count'?)");
+  }
+}
+
+TEST(Config, NoSuggestionWhenNothingIsKnown) {
+  Config c;
+  c.set("x.y=1");
+  try {
+    c.requireAllUsed();
+    FAIL() << "an unused key was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("unknown setting 'x.y' (this command takes no settings)"),
+              std::string::npos)
+        << e.what();
+  }
+}
+
+TEST(Config, CopiesShareTheUsageRecord) {
+  Config c;
+  c.set("demo.lambda=0.3");
+  const Config copy = c;  // e.g. handed to a device context
+  DemoParams p;
+  applyConfig(p, copy, "demo");
+  EXPECT_NO_THROW(c.requireAllUsed());
+  EXPECT_EQ(c.knownKeys().size(), 4u);  // every bound field is known, set or not
+}
+
+TEST(Config, RequireAllUsedExceptSkipsDeferredPrefixes) {
+  Config c;
+  c.set("base.dani.port=5000");
+  EXPECT_NO_THROW(c.requireAllUsedExcept({"base."}));
+  EXPECT_THROW(c.requireAllUsedExcept({"camera."}), InputError);
+}
+
+TEST(Config, ClosestKeyIsTheNearestByEditDistance) {
+  const std::vector<std::string> known = {"servo.lambda", "servo.max_w", "nav.max_w",
+                                          "route.simplify_tolerance"};
+  EXPECT_EQ(closestKey("servo.lamda", known), "servo.lambda");
+  EXPECT_EQ(closestKey("route.simplify_tolerence", known), "route.simplify_tolerance");
+  EXPECT_EQ(closestKey("nav.max_v", known), "nav.max_w");
+  EXPECT_EQ(closestKey("servo.maxw", known), "servo.max_w");
+  EXPECT_EQ(closestKey("anything", {}), "");
+}

@@ -46,6 +46,7 @@ void PerceptionParams::validate() const {
           "must be in [0, 1]");
   require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
   recognition.validate();
+  objectness.validate();
 }
 
 Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
@@ -60,12 +61,13 @@ Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
 struct LandmarkPerception::Impl {
   std::shared_ptr<const landmarks::LandmarkModel> model;
   PerceptionParams p;
-  landmarks::Objectness objectness{landmarks::ObjectnessParams{}};
+  explicit Impl(const landmarks::ObjectnessParams& op) : objectness(op) {}
+  landmarks::Objectness objectness;
 };
 
 LandmarkPerception::LandmarkPerception(std::shared_ptr<const landmarks::LandmarkModel> model,
                                        PerceptionParams params)
-    : impl_(std::make_unique<Impl>()) {
+    : impl_(std::make_unique<Impl>(params.objectness)) {
   params.validate();
   impl_->model = std::move(model);
   impl_->p = params;

@@ -35,3 +35,15 @@ if(SKETCHNAV_BUILD_TESTS)
   target_compile_definitions(test_run_kill PRIVATE SKETCHNAV_EXE="$<TARGET_FILE:sketchnav>")
   gtest_discover_tests(test_run_kill DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600 LABELS cli)
 endif()
+# Strict settings: unknown keys are exit 2 with the closest known key, on every subcommand.
+add_test(NAME cli_settings_strict
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DSRC=${PROJECT_SOURCE_DIR}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings.cmake)
+set_tests_properties(cli_settings_strict PROPERTIES TIMEOUT 300)
+# A short simulated run repeated from its summary's settings as --config: same settings,
+# same outcome.
+add_test(NAME cli_settings_roundtrip
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings-roundtrip
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings_roundtrip.cmake)
+set_tests_properties(cli_settings_roundtrip PROPERTIES TIMEOUT 600)

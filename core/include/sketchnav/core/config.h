@@ -5,10 +5,13 @@
 //
 // A Params struct exposes its fields through `template <class B> void bind(B& b)` calling
 // b("name", field) for each field; applyConfig() then overrides fields from a Config section
-// and calls validate(). Unknown keys are reported by Config::unusedKeys() so typos are caught.
+// and calls validate(). Every bound field is recorded as a known key and every applied one as
+// used, so after a command has applied all the Params it uses, requireAllUsed() turns a typo or
+// a setting the command does not use into an error naming the closest known key.
 #include <nlohmann/json.hpp>
 
 #include <map>
+#include <memory>
 #include <set>
 #include <string>
 #include <vector>
@@ -35,11 +38,23 @@ class Config {
   const Json& at(const std::string& key) const;  // throws InputError when absent
   /// The keys under `prefix.` (prefix empty = all keys).
   std::vector<std::string> keys(const std::string& prefix = "") const;
-  /// Marks a key as consumed; unusedKeys() returns the rest (typos, stale settings).
+  /// Marks a key as consumed (and known); unusedKeys() returns the rest (typos, stale settings).
+  /// Copies of a Config share this record, so a copy handed to a device or a library counts.
   void markUsed(const std::string& key) const;
+  /// Records a key some Params could take (applyConfig records every bound field), for the
+  /// "did you mean" of requireAllUsed().
+  void markKnown(const std::string& key) const;
   std::vector<std::string> unusedKeys(const std::string& prefix = "") const;
-  /// Throws InputError naming the first unused key under `prefix`.
+  /// Every key recorded by markKnown() / markUsed() so far, sorted.
+  std::vector<std::string> knownKeys() const;
+  /// The one-line error for an unused key: "<origin>: unknown setting 'servo.lamda' (did you
+  /// mean 'servo.lambda'?)" - the closest known key by edit distance, when one is known.
+  std::string unknownSettingMessage(const std::string& key) const;
+  /// Throws InputError (unknownSettingMessage) for the first unused key under `prefix`.
   void requireAllUsed(const std::string& prefix = "") const;
+  /// The same over all keys except those under the `deferred` prefixes (e.g. "base." for the
+  /// settings of a device driver, applied only when the device is opened).
+  void requireAllUsedExcept(const std::vector<std::string>& deferred) const;
 
   const std::string& origin(const std::string& key) const;
   Json toJson() const;  // nested form
@@ -47,8 +62,15 @@ class Config {
  private:
   std::map<std::string, Json> values_;
   std::map<std::string, std::string> origins_;
-  mutable std::set<std::string> used_;
+  struct Usage {
+    std::set<std::string> used, known;
+  };
+  std::shared_ptr<Usage> usage_ = std::make_shared<Usage>();
 };
+
+/// The candidate nearest to `key` by edit distance (Levenshtein over characters; ties: the first
+/// in order); "" when `candidates` is empty.
+std::string closestKey(const std::string& key, const std::vector<std::string>& candidates);
 
 namespace detail {
 template <class T>
@@ -66,6 +88,7 @@ class ConfigApplier {
   template <class T>
   void operator()(const char* name, T& field) {
     const std::string key = prefix_.empty() ? name : prefix_ + "." + name;
+    c_.markKnown(key);
     if (!c_.has(key)) return;
     c_.markUsed(key);
     assignFromJson(field, c_.at(key), key, c_.origin(key));

@@ -12,6 +12,7 @@
 #include <opencv2/core/types.hpp>
 
 #include "sketchnav/hw/types.h"
+#include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
 
 namespace sketchnav::landmarks {
@@ -130,6 +131,7 @@ struct PerceptionParams {
   double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
   int window_max_features = 500;  // strongest keypoints kept in the crop (0 = all)
   landmarks::RecognitionParams recognition;  // "landmarks.recognition.*"
+  landmarks::ObjectnessParams objectness;    // "objectness.*" (the windows proposed per frame)
   template <class B>
   void bind(B& b) {
     b("max_windows", max_windows);
