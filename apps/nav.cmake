@@ -4,8 +4,10 @@
 add_library(sketchnav_runharness STATIC run_harness.cpp)
 target_include_directories(sketchnav_runharness PUBLIC ${CMAKE_CURRENT_SOURCE_DIR})
 # nav is public: RunOptions' observer hooks carry nav types (TelemetryRow, Observation).
+# sim and mapsketch are public too: RunSettings (run_harness.h) holds their Params.
 target_link_libraries(sketchnav_runharness PUBLIC sketchnav::core sketchnav::hw sketchnav::nav
-  PRIVATE sketchnav::sim sketchnav::mapsketch sketchnav::landmarks opencv_imgproc
+  sketchnav::sim sketchnav::mapsketch
+  PRIVATE sketchnav::landmarks opencv_imgproc
   opencv_imgcodecs)
 target_compile_options(sketchnav_runharness PRIVATE -Wall -Wextra -Wno-unused-parameter)
 target_link_libraries(sketchnav PRIVATE sketchnav_runharness)
