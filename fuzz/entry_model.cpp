@@ -6,19 +6,6 @@
 #include "sketchnav/landmarks/model.h"
 
 namespace sketchnav::fuzz {
-namespace {
-[[maybe_unused]] std::string text(const std::uint8_t* d, std::size_t n) {
-  return std::string(reinterpret_cast<const char*>(d), n);
-}
-template <class F>
-void refusedIsFine(F&& f) {
-  try {
-    f();
-  } catch (const InputError&) {
-    // the promised outcome for bad input
-  }
-}
-}  // namespace
 
 void model(const std::uint8_t* d, std::size_t n) {
   // The loader reads files; a per-process file in /dev/shm (or /tmp) keeps this cheap.

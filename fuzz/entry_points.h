@@ -7,7 +7,24 @@
 #include <cstdint>
 #include <string>
 
+#include "sketchnav/core/error.h"
+
 namespace sketchnav::fuzz {
+
+/// The input bytes as a string.
+inline std::string text(const std::uint8_t* d, std::size_t n) {
+  return std::string(reinterpret_cast<const char*>(d), n);
+}
+
+/// Runs `f`; an InputError is the promised outcome for bad input, so it is swallowed, while any
+/// other exception (or a crash) reaches the fuzzer as a finding.
+template <class F>
+void refusedIsFine(F&& f) {
+  try {
+    f();
+  } catch (const InputError&) {
+  }
+}
 
 void sketch(const std::uint8_t* data, std::size_t size);
 void world(const std::uint8_t* data, std::size_t size);

@@ -4,19 +4,6 @@
 #include "sketchnav/hw/base_protocol.h"
 
 namespace sketchnav::fuzz {
-namespace {
-[[maybe_unused]] std::string text(const std::uint8_t* d, std::size_t n) {
-  return std::string(reinterpret_cast<const char*>(d), n);
-}
-template <class F>
-void refusedIsFine(F&& f) {
-  try {
-    f();
-  } catch (const InputError&) {
-    // the promised outcome for bad input
-  }
-}
-}  // namespace
 
 void baseProtocol(const std::uint8_t* d, std::size_t n) {
   hw::proto::Message m;

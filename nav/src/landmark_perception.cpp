@@ -124,6 +124,20 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   d.elevation = elevationOf(off, K, P.camera_pitch);
   return true;
 }
+// A match made on `crop` of the frame resized to `patch` pixels, in frame pixels (inliers and
+// homography; per axis, since resize rounds the scaled size).
+void toFramePixels(landmarks::MatchResult& m, const cv::Rect& crop, cv::Size patch) {
+  const double sx = static_cast<double>(patch.width) / crop.width,
+               sy = static_cast<double>(patch.height) / crop.height;
+  for (auto& p : m.x_t)
+    p = {static_cast<float>(crop.x + p.x / sx), static_cast<float>(crop.y + p.y / sy)};
+  if (!m.H.empty()) {
+    const cv::Mat A = (cv::Mat_<double>(3, 3) << 1 / sx, 0, crop.x, 0, 1 / sy, crop.y, 0, 0, 1);
+    m.H = A * m.H;
+  }
+  m.window = crop;
+}
+
 // Indices of the frame keypoints inside `box` (empty box = the whole frame).
 std::vector<int> keypointsIn(const landmarks::FrameFeatures& f, const cv::Rect& box) {
   std::vector<int> out;
@@ -177,13 +191,7 @@ bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   }
   bool placed = false;
   if (m.matched) {
-    const double sx = static_cast<double>(patch.cols) / crop.width,
-                 sy = static_cast<double>(patch.rows) / crop.height;
-    for (auto& p : m.x_t)
-      p = {static_cast<float>(crop.x + p.x / sx), static_cast<float>(crop.y + p.y / sy)};
-    const cv::Mat A = (cv::Mat_<double>(3, 3) << 1 / sx, 0, crop.x, 0, 1 / sy, crop.y, 0, 0, 1);
-    m.H = A * m.H;
-    m.window = crop;
+    toFramePixels(m, crop, patch.size());
     placed = toDetection(m, r.class_name, crop, img.cols, K, P, d);
   }
   // Without geometry there is no position: a window's centre is not the landmark's (a window
@@ -376,16 +384,7 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
     }
     if (!m.matched) continue;
 
-    // Crop pixels -> full-frame pixels (per axis: resize rounds the scaled size).
-    const double sx = static_cast<double>(patch.cols) / cw,
-                 sy = static_cast<double>(patch.rows) / ch;
-    for (auto& p : m.x_t)
-      p = {static_cast<float>(crop.x + p.x / sx), static_cast<float>(crop.y + p.y / sy)};
-    if (!m.H.empty()) {
-      const cv::Mat A = (cv::Mat_<double>(3, 3) << 1 / sx, 0, crop.x, 0, 1 / sy, crop.y, 0, 0, 1);
-      m.H = A * m.H;
-    }
-    m.window = crop;
+    toFramePixels(m, crop, patch.size());
     Detection d;
     // The window drawn for it: the matched keypoints' extent, inside the crop.
     const cv::Rect box = cv::boundingRect(m.x_t) & crop;
