@@ -260,9 +260,7 @@ int runEval(const Args& args, GlobalOptions& g) {
       throw InputError((dirs[s] / "sequence.json").string() + ": target " + seqs[s].target +
                        " is not a class of the model");
   const std::string out = makeOutputDir(args.get("out"));
-  nav::PerceptionParams pp;
-  applyConfig(pp, g.config, "nav.perception");
-  pp.validate();
+  const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
   servo::TurnLawParams tp;
   applyConfig(tp, g.config, "servo");
   tp.validate();
@@ -447,11 +445,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     for (const auto& c : cls) known += (known.empty() ? "" : ", ") + c;
     throw InputError("--target " + target + ": not a class of the model (" + known + ")");
   }
-  nav::PerceptionParams pp;
-  applyConfig(pp, g.config, "nav.perception");
-  applyConfig(pp.recognition, g.config, "landmarks.recognition");
-  pp.objectness = landmarks::objectnessParamsFrom(g.config);
-  pp.validate();
+  const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
   servo::TurnLawParams tp;
   applyConfig(tp, g.config, "servo");
   tp.validate();

@@ -69,16 +69,22 @@ struct TrainingTexture {
 
 std::vector<TrainingTexture> trainingTextures(const sim::World& w,
                                               const landmarks::LandmarkModel& model) {
-  std::vector<TrainingTexture> out;
+  std::vector<std::string> files;
+  std::vector<cv::Mat> images;
   std::set<std::string> seen;
   for (const auto& l : w.landmarks)
     for (const std::string& tex : {l.texture, l.back_texture}) {
       if (tex.empty() || !seen.insert(tex).second) continue;
-      const cv::Mat img = cv::imread(tex, cv::IMREAD_COLOR);
+      cv::Mat img = cv::imread(tex, cv::IMREAD_COLOR);
       if (img.empty()) throw InputError("texture '" + tex + "' cannot be read as an image");
-      const auto hits = landmarks::findTrainingPhotos(model, img);
-      if (!hits.empty()) out.push_back({tex, hits.front().photo, hits.front().distance});
+      files.push_back(tex);
+      images.push_back(std::move(img));
     }
+  const auto hits = landmarks::findTrainingPhotos(model, images);
+  std::vector<TrainingTexture> out;
+  for (size_t i = 0; i < files.size(); ++i)
+    if (!hits[i].empty())
+      out.push_back({files[i], hits[i].front().photo, hits[i].front().distance});
   return out;
 }
 
@@ -324,9 +330,7 @@ RunSettings runSettingsFrom(const Config& c) {
   applyConfig(r.route, c, "route");
   applyConfig(r.train, c, "landmarks.train");
   r.nav = nav::navSettingsFrom(c);
-  applyConfig(r.perception, c, "nav.perception");
-  applyConfig(r.perception.recognition, c, "landmarks.recognition");
-  r.perception.objectness = landmarks::objectnessParamsFrom(c);
+  r.perception = nav::perceptionParamsFrom(c);
   applyConfig(r.sim, c, "sim");
   return r;
 }

@@ -27,18 +27,28 @@ int hashDistance(std::uint64_t a, std::uint64_t b) {
   return static_cast<int>(std::bitset<64>(a ^ b).count());
 }
 
+std::vector<std::vector<TrainingPhotoHit>> findTrainingPhotos(const LandmarkModel& model,
+                                                              const std::vector<cv::Mat>& images,
+                                                              int max_bits) {
+  std::vector<std::pair<std::uint64_t, const DatabasePhoto*>> photos;
+  for (const auto& p : model.photos())
+    if (!p.thumbnail.empty()) photos.push_back({perceptualHash(p.thumbnail), &p});
+  std::vector<std::vector<TrainingPhotoHit>> out;
+  for (const auto& image : images) {
+    const std::uint64_t h = perceptualHash(image);
+    std::vector<TrainingPhotoHit> hits;
+    for (const auto& [ph, p] : photos)
+      if (const int d = hashDistance(h, ph); d <= max_bits) hits.push_back({p->path, d});
+    std::sort(hits.begin(), hits.end(),
+              [](const auto& a, const auto& b) { return a.distance < b.distance; });
+    out.push_back(std::move(hits));
+  }
+  return out;
+}
+
 std::vector<TrainingPhotoHit> findTrainingPhotos(const LandmarkModel& model, const cv::Mat& image,
                                                  int max_bits) {
-  const std::uint64_t h = perceptualHash(image);
-  std::vector<TrainingPhotoHit> hits;
-  for (const auto& p : model.photos()) {
-    if (p.thumbnail.empty()) continue;
-    const int d = hashDistance(h, perceptualHash(p.thumbnail));
-    if (d <= max_bits) hits.push_back({p.path, d});
-  }
-  std::sort(hits.begin(), hits.end(),
-            [](const auto& a, const auto& b) { return a.distance < b.distance; });
-  return hits;
+  return findTrainingPhotos(model, std::vector<cv::Mat>{image}, max_bits).front();
 }
 
 }  // namespace sketchnav::landmarks

@@ -49,6 +49,15 @@ void PerceptionParams::validate() const {
   objectness.validate();
 }
 
+PerceptionParams perceptionParamsFrom(const Config& config) {
+  PerceptionParams p;
+  applyConfig(p, config, "nav.perception");
+  applyConfig(p.recognition, config, "landmarks.recognition");
+  p.objectness = landmarks::objectnessParamsFrom(config);
+  p.validate();
+  return p;
+}
+
 Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
                                 const std::vector<LookFor>& look_for) {
   std::vector<std::string> classes;

@@ -34,5 +34,9 @@ struct TrainingPhotoHit {
 /// The model's database photos within `max_bits` of `image`'s perceptual hash, nearest first.
 std::vector<TrainingPhotoHit> findTrainingPhotos(const LandmarkModel& model, const cv::Mat& image,
                                                  int max_bits = kNearDuplicateBits);
+/// The same for several images (the model's photos hashed once): one list per image.
+std::vector<std::vector<TrainingPhotoHit>> findTrainingPhotos(const LandmarkModel& model,
+                                                              const std::vector<cv::Mat>& images,
+                                                              int max_bits = kNearDuplicateBits);
 
 }  // namespace sketchnav::landmarks

@@ -11,6 +11,7 @@
 
 #include <opencv2/core/types.hpp>
 
+#include "sketchnav/core/config.h"
 #include "sketchnav/hw/types.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
@@ -163,6 +164,11 @@ struct PerceptionParams {
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
 };
+
+/// The perception settings of a run or replay from `config`: "nav.perception.*", with its
+/// recognition settings from "landmarks.recognition.*" and its objectness from "objectness.*";
+/// validated. One assembly for `run`, `replay` and `replay --eval`.
+PerceptionParams perceptionParamsFrom(const Config& config);
 
 /// Objectness + RootSIFT matching on the landmark model. Keeps a reference to the model
 /// (shared ownership). Thread-compatible (one observe() at a time).
