@@ -456,6 +456,7 @@ SequenceTruth readSequenceJson(const std::string& path) {
     s.shown = j.at("shown").get<std::string>();
     s.absent = j.at("absent").get<bool>();
     s.motion = j.at("motion").get<std::string>();
+    s.photo = j.value("photo", std::string());
     for (const auto& f : j.at("frames")) {
       FrameTruth t;
       t.target_present = f.at("target_present").get<bool>();

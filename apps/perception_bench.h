@@ -112,6 +112,7 @@ struct SequenceTruth {
   std::string shown;    // the class whose photo is pasted (== target unless absent)
   bool absent = false;  // a target-absent sequence
   std::string motion;   // "pan" | "approach"
+  std::string photo;    // the pasted photo, relative to the data folder ("" when not recorded)
   std::map<std::string, FrameTruth> frames;
 };
 SequenceTruth readSequenceJson(const std::string& path);

@@ -351,6 +351,7 @@ Json runSettingsJson(const RunSettings& r, bool with_sim) {
   n["movers"] = paramsToJson(r.nav.movers);
   n["goal_door"] = paramsToJson(r.nav.goal_door);
   n["perception"] = paramsToJson(r.perception);
+  n["perception"]["track"] = paramsToJson(r.perception.track);
   j["nav"] = n;
   j["servo"] = paramsToJson(r.nav.servo);
   Json ob = paramsToJson(r.perception.objectness);

@@ -27,6 +27,11 @@ void MatchParams::validate() const {
   require(colour_tolerance >= 0, "match.colour_tolerance", "must be >= 0 (0 = off)");
   require(colour_min_fraction >= 0 && colour_min_fraction <= 1, "match.colour_min_fraction",
           "must be in [0, 1]");
+  require(distinct_min_fraction >= 0 && distinct_min_fraction <= 1, "match.distinct_min_fraction",
+          "must be in [0, 1] (0 = off)");
+  require(distinct_ratio > 0 && distinct_ratio <= 1, "match.distinct_ratio", "must be in (0, 1]");
+  require(distinct_neighbours >= 2, "match.distinct_neighbours", "must be >= 2");
+  require(distinct_checks >= 1, "match.distinct_checks", "must be >= 1");
 }
 
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr) {
@@ -49,7 +54,10 @@ namespace {
 bool sameVerification(const MatchParams& a, const MatchParams& b) {
   return a.ratio == b.ratio && a.min_inliers == b.min_inliers && a.ransac_px == b.ransac_px &&
          a.ransac_iterations == b.ransac_iterations && a.colour_tolerance == b.colour_tolerance &&
-         a.colour_min_fraction == b.colour_min_fraction;
+         a.colour_min_fraction == b.colour_min_fraction &&
+         a.distinct_min_fraction == b.distinct_min_fraction &&
+         a.distinct_ratio == b.distinct_ratio && a.distinct_neighbours == b.distinct_neighbours &&
+         a.distinct_checks == b.distinct_checks;
 }
 }  // namespace
 
@@ -102,6 +110,45 @@ int ransacIterations(int n, int min_inliers, int max_iterations, double confiden
   return static_cast<int>(std::clamp<double>(needed, 1, max_iterations));
 }
 
+namespace {
+// How many of the inlier correspondences `inl` to a photo of class `class_id` are distinct:
+// closer than distinct_ratio x the frame keypoint's nearest database descriptor of another
+// class. A keypoint whose neighbours searched are all of the class has no other-class rival
+// found: distinct.
+int countDistinct(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
+                  int class_id, const std::vector<Corr>& inl, const MatchParams& p) {
+  if (!frame.photo_cache || frame.features.descriptors.empty()) return static_cast<int>(inl.size());
+  const FrameFeatures::PhotoCache::Neighbours* nb = nullptr;
+  {
+    std::lock_guard<std::mutex> lock(frame.photo_cache->mutex);
+    auto& slot = frame.photo_cache->neighbours[{static_cast<const void*>(&model),
+                                                p.distinct_neighbours, p.distinct_checks}];
+    if (slot.indices.empty())
+      model.knnAll(frame.features.descriptors, p.distinct_neighbours, p.distinct_checks,
+                   slot.indices, slot.dists);
+    nb = &slot;  // std::map nodes are stable
+  }
+  const float r2 = static_cast<float>(p.distinct_ratio * p.distinct_ratio);
+  int distinct = 0;
+  for (const auto& c : inl) {
+    const int row = q.idx[c.q];
+    if (row >= nb->indices.rows) continue;
+    const int* id = nb->indices.ptr<int>(row);
+    const float* d2 = nb->dists.ptr<float>(row);
+    float other = std::numeric_limits<float>::infinity();
+    for (int k = 0; k < nb->indices.cols; ++k) {
+      if (id[k] < 0) break;
+      if (model.photos()[model.globalOwner(id[k]).first].class_id != class_id) {
+        other = d2[k];
+        break;
+      }
+    }
+    distinct += c.dist < r2 * other ? 1 : 0;
+  }
+  return distinct;
+}
+}  // namespace
+
 MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
                         const WindowQuery& q, int photo, std::vector<Corr> corr,
                         const MatchParams& p) {
@@ -153,11 +200,13 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
       H.at<double>(0, 0) * H.at<double>(1, 1) - H.at<double>(0, 1) * H.at<double>(1, 0);
   if (!(det > 1.0 / 900 && det < 900)) return r;
   int inl = 0;
+  std::vector<Corr> inlier_corr;
   for (size_t i = 0; i < mask.size(); ++i)
     if (mask[i]) {
       ++inl;
       r.x_d.push_back(src[i]);
       r.x_t.push_back(dst[i]);
+      inlier_corr.push_back(corr[i]);
     }
   r.inliers = inl;
   r.H = H;
@@ -173,7 +222,12 @@ MatchResult ransacPhoto(const LandmarkModel& model, const FrameFeatures& frame,
     }
   }
   r.wrong_colour = wrong;
-  if (inl >= p.min_inliers && inl >= p.colour_min_fraction * (inl + wrong)) {
+  bool distinct_ok = true;
+  if (p.distinct_min_fraction > 0 && inl >= p.min_inliers) {
+    r.distinct_inliers = countDistinct(model, frame, q, ph.class_id, inlier_corr, p);
+    distinct_ok = r.distinct_inliers >= p.distinct_min_fraction * inl;
+  }
+  if (inl >= p.min_inliers && inl >= p.colour_min_fraction * (inl + wrong) && distinct_ok) {
     r.matched = true;
     r.confidence = static_cast<float>(1.0 - std::exp(-(inl - p.min_inliers + 1) / 15.0));
   } else {

@@ -6,6 +6,8 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <limits>
+#include <map>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/landmarks/matcher.h"
@@ -21,6 +23,8 @@ void PerceptionParams::validate() const {
   require(min_inliers >= 4, "nav.perception.min_inliers", "must be >= 4 (a homography)");
   require(ratio > 0 && ratio < 1, "nav.perception.ratio", "must be in (0, 1)");
   require(max_photos >= 1, "nav.perception.max_photos", "must be >= 1");
+  require(distinct_min_fraction >= 0 && distinct_min_fraction <= 1,
+          "nav.perception.distinct_min_fraction", "must be in [0, 1] (0 = off)");
   require(merge_iou > 0 && merge_iou <= 1, "nav.perception.merge_iou", "must be in (0, 1]");
   require(frame_max_side >= 64, "nav.perception.frame_max_side", "must be >= 64 px");
   require(frame_max_features >= 0, "nav.perception.frame_max_features", "must be >= 0");
@@ -45,6 +49,7 @@ void PerceptionParams::validate() const {
   require(window_margin >= 0 && window_margin <= 1, "nav.perception.window_margin",
           "must be in [0, 1]");
   require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
+  track.validate();
   recognition.validate();
   objectness.validate();
 }
@@ -52,6 +57,7 @@ void PerceptionParams::validate() const {
 PerceptionParams perceptionParamsFrom(const Config& config) {
   PerceptionParams p;
   applyConfig(p, config, "nav.perception");
+  applyConfig(p.track, config, "nav.perception.track");
   applyConfig(p.recognition, config, "landmarks.recognition");
   p.objectness = landmarks::objectnessParamsFrom(config);
   p.validate();
@@ -72,6 +78,15 @@ struct LandmarkPerception::Impl {
   PerceptionParams p;
   explicit Impl(const landmarks::ObjectnessParams& op) : objectness(op) {}
   landmarks::Objectness objectness;
+  // Detect, then track: per looked-for class, the landmark last detected and followed since.
+  struct Track {
+    KltTrack klt;
+    Detection detected;   // the detection it started from (recognised_only, confidence)
+    int unconfirmed = 0;  // observe() calls since a full pass last detected it
+  };
+  std::map<std::string, Track> tracks;
+  int since_full = std::numeric_limits<int>::max() / 2;  // observe() calls since the full pass
+  cv::Size frame_size;
 };
 
 LandmarkPerception::LandmarkPerception(std::shared_ptr<const landmarks::LandmarkModel> model,
@@ -98,6 +113,7 @@ landmarks::MatchParams matchParams(const PerceptionParams& P) {
   mp.ratio = P.ratio;
   mp.min_inliers = P.min_inliers;
   mp.max_photos = P.max_photos;
+  mp.distinct_min_fraction = P.distinct_min_fraction;
   return mp;
 }
 
@@ -131,6 +147,7 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   d.bearing = P.camera_yaw - std::atan(d.x_t);
   d.photo = m.database_photo;
   d.elevation = elevationOf(off, K, P.camera_pitch);
+  d.match = std::make_shared<const landmarks::MatchResult>(m);
   return true;
 }
 // A match made on `crop` of the frame resized to `patch` pixels, in frame pixels (inliers and
@@ -262,14 +279,15 @@ void mergeDetection(std::vector<Detection>& found, const Detection& d, double me
 }
 }  // namespace
 
-Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
-                                        const std::vector<std::string>& classes) {
+Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intrinsics& K,
+                                         const std::vector<std::string>& classes) {
   using clk = std::chrono::steady_clock;
   const auto& P = impl_->p;
   const auto& model = *impl_->model;
   Observation ob;
   const auto t0 = clk::now();
   if (frame.image.empty() || classes.empty()) return ob;
+  ob.timing.full_pass = true;
 
   auto t = clk::now();
   const auto windows = impl_->objectness.propose(frame.image, P.max_windows);
@@ -319,18 +337,12 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
   return ob;
 }
 
-Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
-                                        const std::vector<LookFor>& look_for) {
+void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics& K,
+                                   const std::vector<LookFor>& look_for, Observation& ob) {
   using clk = std::chrono::steady_clock;
   const auto& P = impl_->p;
   const auto& model = *impl_->model;
-  const auto t0 = clk::now();
-  std::vector<std::string> classes;
-  for (const auto& l : look_for)
-    if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
-      classes.push_back(l.class_name);
-  Observation ob = observe(frame, K, classes);
-  if (!P.fovea || frame.image.empty()) return ob;
+  if (!P.fovea || frame.image.empty()) return;
 
   const auto tf = clk::now();
   const cv::Mat& img = frame.image;
@@ -405,6 +417,109 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
   std::sort(ob.detections.begin(), ob.detections.end(),
             [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
   ob.timing.fovea_ms = msSince(tf);
+  ob.timing.total_ms += ob.timing.fovea_ms;
+}
+
+namespace {
+std::vector<std::string> classesOf(const std::vector<LookFor>& look_for) {
+  std::vector<std::string> classes;
+  for (const auto& l : look_for)
+    if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
+      classes.push_back(l.class_name);
+  return classes;
+}
+}  // namespace
+
+Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
+                                        const std::vector<std::string>& classes) {
+  return observeFrame(frame, K, classes, nullptr);
+}
+
+Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
+                                        const std::vector<LookFor>& look_for) {
+  return observeFrame(frame, K, classesOf(look_for), &look_for);
+}
+
+void LandmarkPerception::reset() {
+  impl_->tracks.clear();
+  impl_->since_full = std::numeric_limits<int>::max() / 2;
+}
+
+// Detect, then track (TrackParams): the looked-for classes being tracked are followed into this
+// frame; the full pass runs when none is tracked or every track.redetect_frames calls, and its
+// detections (re)start the tracks. A tracked landmark the full pass missed keeps its tracked
+// position until track.max_unconfirmed_frames calls pass without a detection.
+Observation LandmarkPerception::observeFrame(const hw::Frame& frame, const hw::Intrinsics& K,
+                                             const std::vector<std::string>& classes,
+                                             const std::vector<LookFor>* look_for) {
+  using clk = std::chrono::steady_clock;
+  auto& I = *impl_;
+  const auto& P = I.p;
+  const auto t0 = clk::now();
+  if (frame.image.empty() || classes.empty()) return {};
+  const bool track = P.track.enabled;
+  if (frame.image.size() != I.frame_size) reset();  // another camera or resolution
+  I.frame_size = frame.image.size();
+  cv::Mat grey;
+  std::vector<Detection> followed;
+  double track_ms = 0;
+  if (track) {
+    const auto tt = clk::now();
+    if (frame.image.channels() == 3)
+      cv::cvtColor(frame.image, grey, cv::COLOR_BGR2GRAY);
+    else if (frame.image.channels() == 4)
+      cv::cvtColor(frame.image, grey, cv::COLOR_BGRA2GRAY);
+    else
+      grey = frame.image.clone();
+    if (grey.type() != CV_8UC1) grey.convertTo(grey, CV_8U);
+    for (auto it = I.tracks.begin(); it != I.tracks.end();) {
+      auto& tr = it->second;
+      landmarks::MatchResult m;
+      const bool looked = std::find(classes.begin(), classes.end(), it->first) != classes.end();
+      if (!looked || ++tr.unconfirmed > P.track.max_unconfirmed_frames || !tr.klt.step(grey, m)) {
+        it = I.tracks.erase(it);
+        continue;
+      }
+      Detection d;
+      if (toDetection(m, it->first, m.window, frame.image.cols, K, P, d)) {
+        d.tracked = true;
+        d.recognised_only = tr.detected.recognised_only;
+        d.confidence = tr.detected.confidence;
+        if (d.recognised_only) d.elevation = NAN;  // as the detection it follows
+        followed.push_back(d);
+      }
+      ++it;
+    }
+    track_ms = msSince(tt);
+  }
+  const bool full = !track || followed.empty() || ++I.since_full >= P.track.redetect_frames;
+  Observation ob;
+  if (full) {
+    ob = fullPass(frame, K, classes);
+    if (look_for) foveaPass(frame, K, *look_for, ob);
+    I.since_full = 0;
+  }
+  if (track) {
+    // The full pass's detections restart their class's track (the detector is the authority);
+    // a followed landmark it missed stays, as tracked.
+    std::vector<std::string> detected;
+    for (const auto& d : ob.detections) {
+      if (std::find(detected.begin(), detected.end(), d.class_name) != detected.end()) continue;
+      detected.push_back(d.class_name);  // the best (first after sorting) of each class
+      if (!d.match) continue;
+      auto& tr = I.tracks[d.class_name];
+      tr = Impl::Track{KltTrack(P.track), d, 0};
+      if (!tr.klt.start(grey, *d.match)) I.tracks.erase(d.class_name);
+    }
+    for (const auto& d : followed)
+      if (std::find(detected.begin(), detected.end(), d.class_name) == detected.end()) {
+        ob.detections.push_back(d);
+        ++ob.timing.tracked;
+      }
+    std::sort(ob.detections.begin(), ob.detections.end(),
+              [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
+    ob.timing.track_ms = track_ms;
+  }
   ob.timing.total_ms = msSince(t0);
   return ob;
 }

@@ -51,12 +51,14 @@ cv::Mat sceneWith(const cv::Mat& photo, int width, double u, double v, unsigned 
       cv::putText(img, std::to_string(rng.uniform(10, 9999)), a, cv::FONT_HERSHEY_SIMPLEX,
                   rng.uniform(0.4, 1.2), c, 1);
   }
-  cv::Mat small;
-  const double s = static_cast<double>(width) / photo.cols;
-  cv::resize(photo, small, cv::Size(), s, s, cv::INTER_AREA);
-  const cv::Rect at(static_cast<int>(std::lround(u - small.cols / 2.0)),
-                    static_cast<int>(std::lround(v - small.rows / 2.0)), small.cols, small.rows);
-  small.copyTo(img(at));
+  if (width > 0) {  // 0: the scene without the photo
+    cv::Mat small;
+    const double s = static_cast<double>(width) / photo.cols;
+    cv::resize(photo, small, cv::Size(), s, s, cv::INTER_AREA);
+    const cv::Rect at(static_cast<int>(std::lround(u - small.cols / 2.0)),
+                      static_cast<int>(std::lround(v - small.rows / 2.0)), small.cols, small.rows);
+    small.copyTo(img(at));
+  }
   cv::Mat noise(img.size(), CV_16SC3);
   rng.fill(noise, cv::RNG::NORMAL, 0, 2);
   cv::Mat out;
@@ -90,6 +92,9 @@ class FoveaTest : public ::testing::Test {
     p.whole_frame = true;  // the normal pass's best chance: windows and the whole frame
     p.fovea = fovea;
     p.recognise_windows = 0;  // the fovea alone (the recognition stage: RecognitionStage.*)
+    // Each frame on its own: these tests show one perception the same or unrelated frames
+    // (tracking between frames: Tracking.*).
+    p.track.enabled = false;
     return p;
   }
   // The bearing of image column u (what a detection there reports).
@@ -262,6 +267,65 @@ TEST_F(FoveaTest, ElevationIncludesTheCameraTilt) {
 }
 
 // Perception implementations without a fovea get the hinted classes, each once, in order.
+// Detect, then track: a landmark panning across the frame is detected by the full pass every
+// track.redetect_frames frames and followed by the tracker in between, at its true column; it
+// is not followed onto the background once it is gone; reset() forgets the track.
+TEST_F(FoveaTest, TrackingServesTheFramesBetweenFullPasses) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  PerceptionParams p = params(false);
+  p.track.enabled = true;
+  p.track.redetect_frames = 3;
+  LandmarkPerception perception(model_, p);
+  const int width = 180;
+  int tracked = 0;
+  for (int i = 0; i < 9; ++i) {
+    const double u = 200 + 18.0 * i;
+    hw::Frame f;
+    f.image = sceneWith(photo, width, u, 230, 12);
+    const Observation ob = perception.observe(f, K, std::vector<std::string>{kTarget});
+    Detection d;
+    ASSERT_GE(countClass(ob, kTarget, &d), 1) << "frame " << i;  // the best first
+    EXPECT_NEAR(d.x_t, K.normalisedX(u), 0.25 * width / K.fx) << "frame " << i;
+    EXPECT_EQ(ob.timing.full_pass, i % 3 == 0) << "frame " << i;
+    EXPECT_EQ(d.tracked, !ob.timing.full_pass) << "frame " << i;
+    EXPECT_EQ(ob.timing.tracked, d.tracked ? 1 : 0);
+    ASSERT_TRUE(d.match);
+    tracked += d.tracked;
+  }
+  EXPECT_EQ(tracked, 6);
+  // Gone (on a tracker-only call): the track is lost, nothing is reported, and the full pass
+  // runs at once.
+  hw::Frame gone;
+  gone.image = sceneWith(photo, 0, 0, 0, 12);
+  const Observation none = perception.observe(gone, K, std::vector<std::string>{kTarget});
+  EXPECT_EQ(countClass(none, kTarget), 0);
+  EXPECT_TRUE(none.timing.full_pass);
+  // After reset() the first call is a full pass even though the landmark was just detected.
+  hw::Frame back;
+  back.image = sceneWith(photo, width, 300, 230, 12);
+  EXPECT_TRUE(perception.observe(back, K, std::vector<std::string>{kTarget}).timing.full_pass);
+  EXPECT_FALSE(perception.observe(back, K, std::vector<std::string>{kTarget}).timing.full_pass);
+  perception.reset();
+  EXPECT_TRUE(perception.observe(back, K, std::vector<std::string>{kTarget}).timing.full_pass);
+}
+
+// A track is kept only for the classes looked for.
+TEST_F(FoveaTest, TrackingFollowsOnlyLookedForClasses) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  PerceptionParams p = params(false);
+  p.track.enabled = true;
+  p.track.redetect_frames = 2;
+  LandmarkPerception perception(model_, p);
+  hw::Frame f;
+  f.image = sceneWith(photo, 180, 300, 230, 14);
+  ASSERT_GE(countClass(perception.observe(f, K, std::vector<std::string>{kTarget}), kTarget), 1);
+  // Asked for the other class only: the track is dropped, so the next call is a full pass.
+  EXPECT_EQ(countClass(perception.observe(f, K, std::vector<std::string>{kOther}), kTarget), 0);
+  EXPECT_TRUE(perception.observe(f, K, std::vector<std::string>{kTarget}).timing.full_pass);
+}
+
 TEST(PerceptionDefault, LookForForwardsToTheClassesOverload) {
   struct Recorder final : Perception {
     std::vector<std::string> got;

@@ -42,8 +42,14 @@ if(NOT frames EQUAL 4 OR NOT tf EQUAL ${scored} OR NOT bs EQUAL ${scored} OR NOT
   message(FATAL_ERROR "replay --truth: frames ${frames}, truth_frames ${tf}, scored ${bs} "
                       "(truth.csv has ${scored} scored rows), ms ${ms}\n${out}")
 endif()
-run_ok(out err --json replay --eval ${WORK}/seq --out ${WORK}/eval)
+run_ok(out err --json replay --eval ${WORK}/seq --data ${DATA} --out ${WORK}/eval)
 string(JSON frames GET "${out}" frames)
+# The photo ceiling: the two target sequences' photos (of two classes) recognised on their own.
+string(JSON cphotos GET "${out}" photo_ceiling photos)
+string(JSON cok GET "${out}" photo_ceiling photos_recognised)
+if(NOT cphotos EQUAL 2 OR cok LESS 0 OR cok GREATER 2)
+  message(FATAL_ERROR "replay --eval photo_ceiling: ${cphotos} photos, ${cok} recognised\n${out}")
+endif()
 string(JSON nseq GET "${out}" sequences)
 string(JSON absent GET "${out}" absent_frames)
 string(JSON bins LENGTH "${out}" by_yaw_deg)

@@ -45,6 +45,16 @@ struct MatchParams {
   // Not matched when fewer than this fraction of the correspondences consistent with the
   // homography have the right colour (the same artwork on a sibling product).
   double colour_min_fraction = 0.5;
+  // Distinctiveness (a ratio test between classes, after RANSAC): an inlier is distinct when
+  // its database descriptor is closer than distinct_ratio x the frame descriptor's nearest
+  // descriptor of any other class (one approximate search of the whole database per frame,
+  // distinct_neighbours neighbours, distinct_checks leaves). Artwork shared by sibling products
+  // (a brand's logo) gives inliers that are not distinct: not matched when fewer than
+  // distinct_min_fraction of the inliers are distinct. 0 = off.
+  double distinct_min_fraction = 0;
+  double distinct_ratio = 0.9;   // in (0, 1]
+  int distinct_neighbours = 12;  // database neighbours searched per frame keypoint, >= 2
+  int distinct_checks = 32;      // kd-tree leaves checked in that search, >= 1
 
   template <class B>
   void bind(B& b) {
@@ -58,6 +68,10 @@ struct MatchParams {
     b("min_window_features", min_window_features);
     b("colour_tolerance", colour_tolerance);
     b("colour_min_fraction", colour_min_fraction);
+    b("distinct_min_fraction", distinct_min_fraction);
+    b("distinct_ratio", distinct_ratio);
+    b("distinct_neighbours", distinct_neighbours);
+    b("distinct_checks", distinct_checks);
   }
   void validate() const;
 };
@@ -83,6 +97,12 @@ struct FrameFeatures::PhotoCache {
   // window, class and verification settings (recognise + match per frame: one search, not two).
   struct Verified;
   std::vector<Verified> verified;
+  // (model, neighbours, checks) -> the whole database's nearest descriptors of every keypoint
+  // (global rows and squared distances, LandmarkModel::knnAll), for the distinctiveness check.
+  struct Neighbours {
+    cv::Mat indices, dists;
+  };
+  std::map<std::tuple<const void*, int, int>, Neighbours> neighbours;
 };
 FrameFeatures computeFrameFeatures(const LandmarkModel& model, const cv::Mat& bgr);
 /// Same with explicit feature settings for the frame (e.g. a camera frame kept at full
@@ -105,6 +125,8 @@ struct MatchResult {
   cv::Rect window;             // the frame window searched
   int photos_tried = 0;
   int wrong_colour = 0;  // correspondences consistent with H but of another colour (not inliers)
+  int distinct_inliers =
+      -1;  // inliers that are distinct (MatchParams distinct_*); -1 = not checked
 };
 
 struct FrameFeatures::PhotoCache::Verified {
@@ -134,8 +156,8 @@ MatchResult matchPhoto(const LandmarkModel& model, const FrameFeatures& frame,
 /// What the servo needs from a match, in frame pixels.
 struct ServoOffset {
   bool valid = false;
-  float object_u = 0;  // [px] frame column of the matched object's centre: the centre of the
-                       // inliers' extent in the database photo through H
+  float object_u = 0;         // [px] frame column of the matched object's centre: the centre of the
+                              // inliers' extent in the database photo through H
   float offset_px = 0;        // [px] object_u − frame_width / 2 (> 0: object right of centre)
   float paper_offset_px = 0;  // [px] median over inliers of (x_t − frame_cx) − s (x_d − db_cx),
                               //      s = frame/database scale from H: the paper's x_t − x_d

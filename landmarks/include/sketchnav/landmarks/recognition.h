@@ -149,6 +149,7 @@ struct RecognitionParams {
     b("strong_inliers", match.strong_inliers);
     b("min_window_features", match.min_window_features);
     b("colour_tolerance", match.colour_tolerance);
+    b("distinct_min_fraction", match.distinct_min_fraction);
     b("colour_min_fraction", match.colour_min_fraction);
   }
   void validate() const;

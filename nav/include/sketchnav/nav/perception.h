@@ -15,6 +15,7 @@
 #include "sketchnav/hw/types.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
+#include "sketchnav/nav/klt_track.h"
 
 namespace sketchnav::landmarks {
 class LandmarkModel;
@@ -39,6 +40,12 @@ struct Detection {
   // true: found by recognition (votes, BoW, colour) with fewer than min_inliers inliers; its
   // column is from a looser match, and it has no elevation (NaN).
   bool recognised_only = false;
+  // true: followed by the tracker (KltTrack) from an earlier frame's detection, not detected
+  // in this frame.
+  bool tracked = false;
+  // The verified match behind it, in frame pixels (inliers, homography, database photo): what
+  // a tracker starts from and an overlay draws. Null for a Perception that does not match.
+  std::shared_ptr<const landmarks::MatchResult> match;
 };
 
 struct PerceptionTiming {
@@ -48,6 +55,9 @@ struct PerceptionTiming {
   int recognised = 0;       // windows recognised (recognise_windows at most)
   int windows = 0;          // objectness windows examined
   int fovea_looks = 0;      // foveal crops examined (a hinted class missed by the normal pass)
+  bool full_pass = false;   // the full pass (objectness, features, matching) ran on this frame
+  double track_ms = 0;      // wall time of the tracker's steps (part of total_ms)
+  int tracked = 0;          // detections that come from the tracker
 };
 
 /// A class to look for, with where the executive expects it (from the sketch). Without a
@@ -74,6 +84,9 @@ class Perception {
   /// class the normal pass missed. Detections are in full-frame coordinates either way.
   virtual Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
                               const std::vector<LookFor>& look_for);
+  /// Forgets what earlier frames showed (tracks): the next frame does not follow the last one
+  /// (another sequence, a camera restarted). The default has nothing to forget.
+  virtual void reset() {}
 };
 
 struct PerceptionParams {
@@ -82,6 +95,11 @@ struct PerceptionParams {
   int min_inliers = 12;      // RANSAC inliers for a detection (never a guess below)
   double ratio = 0.8;        // Lowe ratio test
   int max_photos = 3;        // database photos tried per window
+  // Fraction of a match's inliers that must be distinct: closer to the class's photo than
+  // landmarks::MatchParams::distinct_ratio x the nearest descriptor of any other class (artwork
+  // a sibling product shares is not evidence for either). In [0, 1]; 0 = off. The evidence for
+  // the default: doc/perception-benchmark.md "Distinct inliers".
+  double distinct_min_fraction = 0.3;
   bool paper_offset = true;  // feature from the paper's median (x_t - x_d) over inliers;
                              // false: the homography-projected object centre
   double camera_yaw = 0;     // [rad] camera pan on the robot (bearing = yaw - atan(x))
@@ -131,6 +149,7 @@ struct PerceptionParams {
   int window_side = 256;          // [px] a recognised window is cropped and scaled to this side
   double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
   int window_max_features = 500;  // strongest keypoints kept in the crop (0 = all)
+  TrackParams track;              // "nav.perception.track.*" (detect, then track)
   landmarks::RecognitionParams recognition;  // "landmarks.recognition.*"
   landmarks::ObjectnessParams objectness;    // "objectness.*" (the windows proposed per frame)
   template <class B>
@@ -140,6 +159,7 @@ struct PerceptionParams {
     b("min_inliers", min_inliers);
     b("ratio", ratio);
     b("max_photos", max_photos);
+    b("distinct_min_fraction", distinct_min_fraction);
     b("paper_offset", paper_offset);
     b("camera_yaw", camera_yaw);
     b("camera_pitch", camera_pitch);
@@ -166,12 +186,16 @@ struct PerceptionParams {
 };
 
 /// The perception settings of a run or replay from `config`: "nav.perception.*", with its
-/// recognition settings from "landmarks.recognition.*" and its objectness from "objectness.*";
+/// recognition settings from "landmarks.recognition.*", its tracking from
+/// "nav.perception.track.*" and its objectness from "objectness.*";
 /// validated. One assembly for `run`, `replay` and `replay --eval`.
 PerceptionParams perceptionParamsFrom(const Config& config);
 
-/// Objectness + RootSIFT matching on the landmark model. Keeps a reference to the model
-/// (shared ownership). Thread-compatible (one observe() at a time).
+/// Objectness + RootSIFT matching on the landmark model; between full passes (every
+/// track.redetect_frames calls) a detected landmark is followed by a KltTrack. Keeps a
+/// reference to the model (shared ownership). Thread-compatible (one observe() at a time).
+/// Stateful: consecutive observe() calls are taken as consecutive frames of one camera;
+/// reset() between unrelated frames.
 class LandmarkPerception final : public Perception {
  public:
   LandmarkPerception(std::shared_ptr<const landmarks::LandmarkModel> model,
@@ -183,8 +207,16 @@ class LandmarkPerception final : public Perception {
   /// fovea_*) at each hinted class it missed.
   Observation observe(const hw::Frame& frame, const hw::Intrinsics& k,
                       const std::vector<LookFor>& look_for) override;
+  void reset() override;
 
  private:
+  Observation observeFrame(const hw::Frame& frame, const hw::Intrinsics& k,
+                           const std::vector<std::string>& classes,
+                           const std::vector<LookFor>* look_for);
+  Observation fullPass(const hw::Frame& frame, const hw::Intrinsics& k,
+                       const std::vector<std::string>& classes);
+  void foveaPass(const hw::Frame& frame, const hw::Intrinsics& k,
+                 const std::vector<LookFor>& look_for, Observation& ob);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
