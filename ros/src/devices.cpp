@@ -205,6 +205,25 @@ class RosBase final : public hw::Base {
           return have_;
         },
         "odometry", sub_.getTopic());
+    // Stamps on another clock than this node's make every input look stale (or fresh forever).
+    double stamp;
+    {
+      std::lock_guard<std::mutex> l(m_);
+      stamp = odom_.stamp;
+    }
+    const double now = ::ros::Time::now().toSec();
+    if (std::abs(now - stamp) > 5.0) {
+      char b[320];
+      std::snprintf(b, sizeof b,
+                    "odometry on %s is stamped %.1f s but this node's ROS time is %.1f s%s",
+                    sub_.getTopic().c_str(), stamp, now,
+                    ::ros::Time::isSimTime()
+                        ? ""
+                        : ": the robot runs on simulated time and this node does not (set "
+                          "/use_sim_time before starting it, e.g. start `sketchnav ros sim` "
+                          "first)");
+      throw RuntimeError(b);
+    }
     detail::addInput(in_);
   }
   ~RosBase() override {

@@ -157,36 +157,60 @@ std::string shortLabSketch(const fs::path& dir) {
   return out;
 }
 
-// One test's ROS world: a master on a free loopback port, this process as a node on it.
+// The ROS world of this test process: a master on a free loopback port and this process as
+// a node on it, made by the first test that needs it (ctest runs each test in a process of
+// its own; a direct run shares one master, as roscpp connects a process once).
+struct RosWorld {
+  fs::path dir;
+  int port = 0;
+  std::unique_ptr<Process> master;
+  std::unique_ptr<ros::NodeHandle> nh;
+  std::unique_ptr<ros::AsyncSpinner> spinner;
+  std::string error;  // why it could not be made
+};
+RosWorld& world() {
+  static RosWorld w;
+  if (w.nh || !w.error.empty()) return w;
+  w.dir = fs::temp_directory_path() / ("sketchnav-test-ros-" + std::to_string(::getpid()));
+  fs::create_directories(w.dir / "roshome");
+  w.port = freePort();
+  ::setenv("ROS_MASTER_URI", ("http://127.0.0.1:" + std::to_string(w.port)).c_str(), 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::unsetenv("ROS_HOSTNAME");
+  ::setenv("ROS_HOME", (w.dir / "roshome").c_str(), 1);
+  w.master = std::make_unique<Process>(
+      std::vector<std::string>{"rosmaster", "--core", "-p", std::to_string(w.port)},
+      (w.dir / "master.out").string(), (w.dir / "master.err").string());
+  const double t0 = wallNow();
+  while (!portOpen(w.port)) {
+    if (wallNow() - t0 > 20.0) {
+      w.error = "rosmaster did not start: " + w.master->err();
+      return w;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  int argc = 1;
+  char name[] = "test_ros";
+  char* argv[] = {name, nullptr};
+  ros::init(argc, argv, "test_ros_observer",
+            ros::init_options::NoSigintHandler | ros::init_options::NoRosout);
+  w.nh = std::make_unique<ros::NodeHandle>();
+  w.spinner = std::make_unique<ros::AsyncSpinner>(1);
+  w.spinner->start();
+  return w;
+}
+
 class RosTest : public ::testing::Test {
  protected:
   void SetUp() override {
     if (!haveRos()) GTEST_SKIP() << "ROS 1 tools (rosmaster) not installed";
-    dir_ = fs::temp_directory_path() /
-           ("sketchnav-test-ros-" + std::to_string(::getpid()) + "-" +
-            ::testing::UnitTest::GetInstance()->current_test_info()->name());
-    fs::create_directories(dir_ / "roshome");
-    port_ = freePort();
-    ::setenv("ROS_MASTER_URI", ("http://127.0.0.1:" + std::to_string(port_)).c_str(), 1);
-    ::setenv("ROS_IP", "127.0.0.1", 1);
-    ::unsetenv("ROS_HOSTNAME");
-    ::setenv("ROS_HOME", (dir_ / "roshome").c_str(), 1);
-    master_ = std::make_unique<Process>(
-        std::vector<std::string>{"rosmaster", "--core", "-p", std::to_string(port_)},
-        (dir_ / "master.out").string(), (dir_ / "master.err").string());
-    const double t0 = wallNow();
-    while (!portOpen(port_)) {
-      ASSERT_LT(wallNow() - t0, 20.0) << "rosmaster did not start: " << master_->err();
-      std::this_thread::sleep_for(std::chrono::milliseconds(50));
-    }
-    int argc = 1;
-    char name[] = "test_ros";
-    char* argv[] = {name, nullptr};
-    ros::init(argc, argv, "test_ros_observer",
-              ros::init_options::NoSigintHandler | ros::init_options::NoRosout);
-    nh_ = std::make_unique<ros::NodeHandle>();
-    spinner_ = std::make_unique<ros::AsyncSpinner>(1);
-    spinner_->start();
+    RosWorld& w = world();
+    ASSERT_TRUE(w.error.empty()) << w.error;
+    nh_ = w.nh.get();
+    dir_ = w.dir / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::create_directories(dir_);
+    // A simulator of an earlier test left simulated time on: this one starts on wall time.
+    ros::param::del("/use_sim_time");
     cmd_sub_ = nh_->subscribe<geometry_msgs::Twist>(
         "cmd_vel", 100, [this](const geometry_msgs::TwistConstPtr& m) {
           std::lock_guard<std::mutex> l(m_);
@@ -196,10 +220,7 @@ class RosTest : public ::testing::Test {
   void TearDown() override {
     nav_.reset();
     sim_.reset();
-    if (spinner_) spinner_->stop();
     cmd_sub_.shutdown();
-    if (ros::isInitialized()) ros::shutdown();
-    master_.reset();
     std::error_code ec;
     if (!HasFailure()) fs::remove_all(dir_, ec);
   }
@@ -209,10 +230,14 @@ class RosTest : public ::testing::Test {
     v.insert(v.end(), args.begin(), args.end());
     return v;
   }
+  // Started before the navigation, as a launch file would: the navigation reads /use_sim_time
+  // when it connects.
   void startSim(const std::string& rate) {
     sim_ = std::make_unique<Process>(
         cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1", "--rate", rate}),
         (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
+    ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20))
+        << "ros sim did not set /use_sim_time" << logs();
   }
   void startNav(const std::string& sketch, std::vector<std::string> extra = {}) {
     auto v = cmd({"--json", "ros", "nav", "--sketch", sketch, "--exit-on-result", "--cache-dir",
@@ -246,10 +271,8 @@ class RosTest : public ::testing::Test {
   }
 
   fs::path dir_;
-  int port_ = 0;
-  std::unique_ptr<Process> master_, sim_, nav_;
-  std::unique_ptr<ros::NodeHandle> nh_;
-  std::unique_ptr<ros::AsyncSpinner> spinner_;
+  std::unique_ptr<Process> sim_, nav_;
+  ros::NodeHandle* nh_ = nullptr;
   ros::Subscriber cmd_sub_;
   std::mutex m_;
   std::vector<Cmd> cmds_;
@@ -258,6 +281,7 @@ class RosTest : public ::testing::Test {
 TEST_F(RosTest, SimAndNavThroughAMasterDriveTheShortLabRoute) {
   const std::string sketch = shortLabSketch(dir_);
   startSim("1");
+  if (HasFatalFailure()) return;
   startNav(sketch, {"--max-time", "60"});
   ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
   EXPECT_EQ(nav_->exitCode(), 0) << logs();
@@ -287,6 +311,7 @@ TEST_F(RosTest, SimAndNavThroughAMasterDriveTheShortLabRoute) {
 
 TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
   startSim("1");
+  if (HasFatalFailure()) return;
   startNav(std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
            {"--max-time", "120"});
   ASSERT_TRUE(waitFor([&] { return moving() || !nav_->running(); }, 120)) << logs();
@@ -321,6 +346,7 @@ TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
   const Json r = Json::parse(nav_->out());
   EXPECT_FALSE(r["success"].get<bool>());
   EXPECT_NE(r["reason"].get<std::string>().find("safety stop"), std::string::npos) << r["reason"];
+  std::printf("reason: %s\n", r["reason"].get<std::string>().c_str());
 }
 
 // Garbage on a topic: a clear log line naming the topic and the problem, a stop, no crash.
@@ -328,6 +354,9 @@ struct Garbage {
   const char* name;
   const char* expect;  // in the node's stderr
 };
+void PrintTo(const Garbage& g, std::ostream* os) {
+  *os << g.name;
+}
 class RosGarbage : public RosTest, public ::testing::WithParamInterface<Garbage> {};
 
 TEST_P(RosGarbage, StopsWithAClearLogLine) {
