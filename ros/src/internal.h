@@ -39,7 +39,7 @@ struct State {
   RosParams params;
   std::string fault;
   std::atomic<bool> tripped{false};
-  std::thread watchdog;
+  std::thread watchdog, liveness;
   std::atomic<bool> watchdog_stop{false};
   std::string camera_frame;
 };

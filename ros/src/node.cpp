@@ -6,11 +6,17 @@
 #include <tf2/LinearMath/Quaternion.h>
 #include <xmlrpcpp/XmlRpcValue.h>
 
+#include <netdb.h>
+#include <poll.h>
+#include <sys/socket.h>
+#include <unistd.h>
 #include <algorithm>
+#include <cerrno>
 #include <chrono>
 #include <cmath>
 #include <csignal>
 #include <cstdio>
+#include <map>
 
 #include "internal.h"
 #include "sketchnav/core/error.h"
@@ -153,6 +159,93 @@ void watchdogLoop() {
   }
 }
 
+// True when nothing listens at the host:port of an XML-RPC URI "http://host:port/": the node
+// behind it has died (a killed node never unregisters from the master). Connecting waits at
+// most 100 ms; a slow answer counts as alive.
+bool refusesConnections(const std::string& uri) {
+  const std::string pre = "http://";
+  if (uri.rfind(pre, 0) != 0) return false;
+  const std::string hp = uri.substr(pre.size(), uri.find('/', pre.size()) - pre.size());
+  const auto colon = hp.rfind(':');
+  if (colon == std::string::npos) return false;
+  addrinfo hints{}, *res = nullptr;
+  hints.ai_socktype = SOCK_STREAM;
+  if (::getaddrinfo(hp.substr(0, colon).c_str(), hp.substr(colon + 1).c_str(), &hints, &res) != 0)
+    return false;
+  bool refused = false;
+  const int fd = ::socket(res->ai_family, SOCK_STREAM | SOCK_NONBLOCK, 0);
+  if (fd >= 0) {
+    if (::connect(fd, res->ai_addr, res->ai_addrlen) != 0) {
+      if (errno == ECONNREFUSED) {
+        refused = true;
+      } else if (errno == EINPROGRESS) {
+        pollfd p{fd, POLLOUT, 0};
+        if (::poll(&p, 1, 100) == 1) {
+          int err = 0;
+          socklen_t n = sizeof err;
+          ::getsockopt(fd, SOL_SOCKET, SO_ERROR, &err, &n);
+          refused = err == ECONNREFUSED;
+        }
+      }
+    }
+    ::close(fd);
+  }
+  ::freeaddrinfo(res);
+  return refused;
+}
+
+// Publisher liveness: every 50 ms, is each input's publisher node still there? A driver (or
+// `ros sim`) that died stops the robot at once, not when its last message gets stale.
+void livenessLoop() {
+  State& s = state();
+  std::map<std::string, std::vector<std::string>> pubs;  // topic -> publisher nodes
+  std::map<std::string, std::string> uris;               // node -> XML-RPC URI
+  double next_state = 0;
+  const std::string me = ::ros::this_node::getName();
+  while (!s.watchdog_stop) {
+    const double now = detail::wallNow();
+    if (now >= next_state) {
+      next_state = now + 1.0;
+      XmlRpc::XmlRpcValue args, result, payload;
+      args[0] = me;
+      if (::ros::master::execute("getSystemState", args, result, payload, false) &&
+          payload.getType() == XmlRpc::XmlRpcValue::TypeArray && payload.size() > 0) {
+        pubs.clear();
+        XmlRpc::XmlRpcValue& p = payload[0];
+        for (int i = 0; i < p.size(); ++i) {
+          std::vector<std::string> nodes;
+          for (int j = 0; j < p[i][1].size(); ++j) nodes.push_back(p[i][1][j]);
+          pubs[p[i][0]] = nodes;
+        }
+      }
+    }
+    std::vector<std::shared_ptr<detail::Input>> inputs;
+    {
+      std::lock_guard<std::mutex> l(s.mutex);
+      inputs = s.inputs;
+    }
+    for (const auto& in : inputs) {
+      if (!in->active || in->wall_last < 0) continue;
+      for (const auto& node : pubs[in->topic]) {
+        if (node == me) continue;
+        if (!uris.count(node)) {
+          XmlRpc::XmlRpcValue args, result, payload;
+          args[0] = me;
+          args[1] = node;
+          if (::ros::master::execute("lookupNode", args, result, payload, false))
+            uris[node] = static_cast<std::string>(payload);
+          else
+            continue;
+        }
+        if (in->active && refusesConnections(uris[node]))
+          trip(in->what + " on " + in->topic + ": its publisher " + node + " is gone (" +
+               uris[node] + " refuses connections)");
+      }
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+}
+
 class RosClock final : public hw::Clock {
  public:
   double now() const override { return ::ros::Time::now().toSec(); }
@@ -225,6 +318,7 @@ void shutdown() {
   if (!s.initialised) return;
   s.watchdog_stop = true;
   if (s.watchdog.joinable()) s.watchdog.join();
+  if (s.liveness.joinable()) s.liveness.join();
   detail::publishZero();
   // Let the zero command and latched messages leave before the connections close.
   std::this_thread::sleep_for(std::chrono::milliseconds(100));
@@ -250,7 +344,10 @@ void startWatchdog(const RosParams& p) {
     std::lock_guard<std::mutex> l(s.mutex);
     s.params = p;
   }
-  if (!s.watchdog.joinable()) s.watchdog = std::thread(watchdogLoop);
+  if (!s.watchdog.joinable()) {
+    s.watchdog = std::thread(watchdogLoop);
+    s.liveness = std::thread(livenessLoop);
+  }
 }
 
 std::string fault() {
