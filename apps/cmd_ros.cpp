@@ -10,6 +10,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/ros/bag.h"
 #include "sketchnav/ros/node.h"
 #include "sketchnav/ros/sim_bridge.h"
 
@@ -212,6 +213,11 @@ int runRos(const std::vector<std::string>& argv, GlobalOptions& g) {
   if (argv[0] == "nav") return runNav(rest, g);
   throw InputError("sketchnav ros: unknown subcommand '" + argv[0] + "' (sim or nav)");
 }
+
+// bag:// cameras for every subcommand that opens a camera URI (replay --frames, probe, run).
+const struct BagDriver {
+  BagDriver() { ros::registerBagDriver(); }
+} bag_driver;
 
 const CommandRegistration reg("ros",
                               "ROS 1: the simulator as a ROS robot (ros sim), the navigation as "

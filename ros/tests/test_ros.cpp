@@ -31,7 +31,14 @@
 #include <thread>
 #include <vector>
 
+#include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <opencv2/imgcodecs.hpp>
+
 #include "sketchnav/core/config.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/hw/registry.h"
+#include "sketchnav/ros/bag.h"
 
 namespace fs = std::filesystem;
 using sketchnav::Json;
@@ -479,6 +486,95 @@ TEST(RosCli, UnknownRosParameterIsRefused) {
   ASSERT_TRUE(nav.wait(30));
   EXPECT_EQ(nav.exitCode(), 2) << nav.err();
   EXPECT_NE(nav.err().find("nav.v_crusie"), std::string::npos) << nav.err();
+  fs::remove_all(dir);
+}
+
+// bag:// camera: frames in bag order with stamps relative to the first, a compressed frame
+// decoded, a broken frame skipped and counted, camera_info as intrinsics, then the end.
+TEST(RosBag, CameraReadsImagesFromABag) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-bag-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string file = (dir / "cam.bag").string();
+  {
+    rosbag::Bag bag(file, rosbag::bagmode::Write);
+    auto image = [](double t, int level) {
+      sensor_msgs::Image im;
+      im.header.stamp = ros::Time(100.0 + t);
+      im.header.frame_id = "camera_optical";
+      im.width = 32;
+      im.height = 24;
+      im.encoding = "bgr8";
+      im.step = 32 * 3;
+      im.data.assign(32 * 24 * 3, static_cast<std::uint8_t>(level));
+      return im;
+    };
+    sensor_msgs::CameraInfo ci;
+    ci.header.stamp = ros::Time(100.0);
+    ci.width = 32;
+    ci.height = 24;
+    ci.K = {30, 0, 15.5, 0, 31, 11.5, 0, 0, 1};
+    bag.write("/cam/camera_info", ros::Time(100.0), ci);
+    bag.write("/cam/image_raw", ros::Time(100.0), image(0.0, 10));
+    bag.write("/cam/image_raw", ros::Time(100.1), image(0.1, 20));
+    sensor_msgs::Image broken = image(0.2, 30);
+    broken.data.resize(10);
+    bag.write("/cam/image_raw", ros::Time(100.2), broken);
+    sensor_msgs::Image mono = image(0.3, 0);
+    mono.encoding = "mono8";
+    mono.step = 32;
+    mono.data.assign(32 * 24, 40);
+    bag.write("/cam/image_raw", ros::Time(100.3), mono);
+    bag.write("/other/image_raw", ros::Time(100.3), image(0.3, 99));
+    sensor_msgs::CompressedImage jpg;
+    jpg.header.stamp = ros::Time(100.4);
+    jpg.format = "jpeg";
+    cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC3, cv::Scalar(50, 50, 50)), jpg.data);
+    bag.write("/cam/image_raw/compressed", ros::Time(100.4), jpg);
+    bag.close();
+  }
+  sketchnav::ros::registerBagDriver();
+  sketchnav::hw::DeviceContext ctx;
+  auto& reg = sketchnav::hw::Registry::instance();
+  // Two image topics: the camera must be told which.
+  try {
+    reg.createCamera("bag://" + file, ctx);
+    FAIL() << "a bag with two image topics opened without ?topic=";
+  } catch (const sketchnav::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("several image topics"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(reg.createCamera("bag://" + file + "?topic=/nope", ctx), sketchnav::InputError);
+  EXPECT_THROW(reg.createCamera("bag:///no/such.bag", ctx), sketchnav::InputError);
+  auto cam = reg.createCamera("bag://" + file + "?topic=/cam/image_raw", ctx);
+  const auto K = cam->intrinsics();
+  EXPECT_EQ(K.width, 32);
+  EXPECT_DOUBLE_EQ(K.fx, 30);
+  EXPECT_DOUBLE_EQ(K.fy, 31);
+  std::vector<double> stamps;
+  std::vector<int> levels;
+  sketchnav::hw::Frame f;
+  while (cam->grab(f, 0.1) == sketchnav::hw::GrabStatus::Ok) {
+    ASSERT_EQ(f.image.type(), CV_8UC3);
+    stamps.push_back(f.stamp);
+    levels.push_back(f.image.at<cv::Vec3b>(5, 5)[0]);
+  }
+  ASSERT_EQ(stamps.size(), 3u);
+  EXPECT_NEAR(stamps[0], 0.0, 1e-6);
+  EXPECT_NEAR(stamps[1], 0.1, 1e-6);
+  EXPECT_NEAR(stamps[2], 0.3, 1e-6);
+  EXPECT_EQ(levels[0], 10);
+  EXPECT_EQ(levels[1], 20);
+  EXPECT_EQ(levels[2], 40);             // mono8 -> bgr8
+  EXPECT_EQ(cam->stats().dropped, 1u);  // the truncated one
+  EXPECT_EQ(cam->stats().received, 3u);
+  EXPECT_EQ(cam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
+  // A compressed image topic; no camera_info beside it: intrinsics from the 60 deg default.
+  auto jcam = reg.createCamera("bag://" + file + "?topic=/cam/image_raw/compressed", ctx);
+  ASSERT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::Ok);
+  EXPECT_EQ(f.image.cols, 32);
+  EXPECT_NEAR(f.image.at<cv::Vec3b>(5, 5)[0], 50, 3);
+  EXPECT_NEAR(jcam->intrinsics().fx, 16 / std::tan(M_PI / 6), 0.1);
+  EXPECT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
   fs::remove_all(dir);
 }
 
