@@ -360,7 +360,8 @@ TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
 // the problem, a stop, no crash.
 struct Garbage {
   const char* name;
-  const char* expect;  // in the node's stderr
+  const char* expect;             // in the node's stderr
+  const char* also_ok = nullptr;  // or this (two supervisors may see it first)
 };
 void PrintTo(const Garbage& g, std::ostream* os) {
   *os << g.name;
@@ -445,7 +446,9 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
   EXPECT_EQ(nav_->exitCode(), 1) << logs();
   const std::string err = nav_->err();
   EXPECT_NE(err.find("safety stop"), std::string::npos) << logs();
-  EXPECT_NE(err.find(g.expect), std::string::npos) << logs();
+  EXPECT_TRUE(err.find(g.expect) != std::string::npos ||
+              (g.also_ok && err.find(g.also_ok) != std::string::npos))
+      << logs();
   const auto c = commands();
   ASSERT_FALSE(c.empty());
   EXPECT_EQ(c.back().v, 0.0);
@@ -458,7 +461,9 @@ INSTANTIATE_TEST_SUITE_P(
                       Garbage{"wrong_encoding", "encoding '32FC1'"},
                       Garbage{"nan_odometry", "odometry on /odom: NaN"},
                       Garbage{"scan_wrong_length", "the scan has 50 ranges"},
-                      Garbage{"frozen_camera", "camera on /image_raw: no message for"},
+                      Garbage{"frozen_camera", "camera on /image_raw: no message for",
+                              // the executive's own check on ROS time, same 0.5 s limit
+                              "safety stop: camera stale: no data for"},
                       Garbage{"sigint", "SIGINT received"}),
     [](const ::testing::TestParamInfo<Garbage>& i) { return std::string(i.param.name); });
 
