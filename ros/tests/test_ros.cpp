@@ -494,6 +494,57 @@ TEST(RosCli, UnknownRosParameterIsRefused) {
   fs::remove_all(dir);
 }
 
+// The master goes away mid-route: the node stops and fails the route saying so. Its own
+// master (not the shared one: this test kills it), observed through the node's result.
+TEST(RosMaster, LosingTheMasterStopsTheRoute) {
+  if (!haveRos()) GTEST_SKIP() << "ROS 1 tools (rosmaster) not installed";
+  const int port = freePort();
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-master-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string uri = "http://127.0.0.1:" + std::to_string(port);
+  const std::string saved = std::getenv("ROS_MASTER_URI") ? std::getenv("ROS_MASTER_URI") : "";
+  ::setenv("ROS_MASTER_URI", uri.c_str(), 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::setenv("ROS_HOME", dir.c_str(), 1);
+  auto master = std::make_unique<Process>(
+      std::vector<std::string>{"rosmaster", "--core", "-p", std::to_string(port)},
+      (dir / "m.out").string(), (dir / "m.err").string());
+  const double t0 = wallNow();
+  while (!portOpen(port)) {
+    ASSERT_LT(wallNow() - t0, 20.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  Process sim({SKETCHNAV_EXE, "ros", "sim", "--world", "lab", "--seed", "1"},
+              (dir / "s.out").string(), (dir / "s.err").string());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // /use_sim_time set
+  Process nav({SKETCHNAV_EXE, "--json", "ros", "nav", "--sketch",
+               std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
+               "--exit-on-result", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR},
+              (dir / "n.out").string(), (dir / "n.err").string());
+  // Until the route runs ("start" is logged when it begins).
+  const double t1 = wallNow();
+  while (nav.running() && nav.err().find("start: ") == std::string::npos && wallNow() - t1 < 120)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(nav.running()) << nav.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  master->signal(SIGKILL);
+  const double killed = wallNow();
+  ASSERT_TRUE(nav.wait(10)) << nav.err();
+  const double ended = wallNow() - killed;
+  EXPECT_EQ(nav.exitCode(), 1) << nav.err();
+  const Json r = Json::parse(nav.out());
+  EXPECT_FALSE(r["success"].get<bool>());
+  EXPECT_NE(r["reason"].get<std::string>().find("ROS master at " + uri + " cannot be reached"),
+            std::string::npos)
+      << r["reason"];
+  std::printf("master killed -> route ended after %.2f s: %s\n", ended,
+              r["reason"].get<std::string>().c_str());
+  sim.signal(SIGKILL);
+  if (!saved.empty()) ::setenv("ROS_MASTER_URI", saved.c_str(), 1);
+  fs::remove_all(dir);
+}
+
 // bag:// camera: frames in bag order with stamps relative to the first, a compressed frame
 // decoded, a broken frame skipped and counted, camera_info as intrinsics, then the end.
 TEST(RosBag, CameraReadsImagesFromABag) {
