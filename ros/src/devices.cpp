@@ -154,10 +154,6 @@ class RosCamera final : public hw::Camera {
       ++seq_;
       ++st_.received;
     }
-    {
-      std::lock_guard<std::mutex> l(state().mutex);
-      state().camera_frame = m->header.frame_id;
-    }
     cv_.notify_all();
   }
   void onInfo(const sensor_msgs::CameraInfoConstPtr& m) {

@@ -41,7 +41,6 @@ struct State {
   std::atomic<bool> tripped{false};
   std::thread watchdog, liveness;
   std::atomic<bool> watchdog_stop{false};
-  std::string camera_frame;
 };
 
 State& state();
