@@ -177,12 +177,21 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   sensor_msgs::ImagePtr img_msg;
   sensor_msgs::CameraInfo info_msg;
 
+  bool collision_logged = false;
   // Reads every device at the clock's time t and publishes what is new.
   auto publishStep = [&](double t) {
     const ::ros::Time rt = rosTime(t);
     clockAt(t);
+    // A collision stops the simulated base for good (its ok() turns false in-process); as a
+    // ROS robot its odometry stops, which the navigation takes for a lost base.
+    if (simr->collided() && !collision_logged) {
+      collision_logged = true;
+      log::error("ros-sim", "collision with " + simr->collisionWith() +
+                                ": the base has stopped; odometry and tf odom -> base_link are "
+                                "no longer published");
+    }
     hw::Odometry od;
-    if (simr->base().odometry(od)) {
+    if (!simr->collided() && simr->base().odometry(od)) {
       nav_msgs::Odometry& m = odom_msg;
       m.header.stamp = rt;
       m.header.frame_id = "odom";

@@ -14,6 +14,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <signal.h>
+#include <std_msgs/String.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -354,6 +355,59 @@ TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
   EXPECT_FALSE(r["success"].get<bool>());
   EXPECT_NE(r["reason"].get<std::string>().find("safety stop"), std::string::npos) << r["reason"];
   std::printf("reason: %s\n", r["reason"].get<std::string>().c_str());
+}
+
+// Driving the simulated robot into something: it collides, its base stops for good and its
+// odometry stops (what tells `ros nav` the base is lost); its ground truth says what was hit.
+TEST_F(RosTest, ACollisionInTheSimulatorStopsItsOdometry) {
+  startSim("2");
+  if (HasFatalFailure()) return;
+  std::mutex om;
+  std::vector<double> odom_wall;
+  auto odom_sub =
+      nh_->subscribe<nav_msgs::Odometry>("odom", 100, [&](const nav_msgs::OdometryConstPtr&) {
+        std::lock_guard<std::mutex> l(om);
+        odom_wall.push_back(wallNow());
+      });
+  auto cmd_pub = nh_->advertise<geometry_msgs::Twist>("cmd_vel", 5);
+  geometry_msgs::Twist fwd;
+  fwd.linear.x = 0.5;
+  // Straight ahead from the lab's start until the simulator reports a collision (or 40 s).
+  bool collided = false;
+  std::string with;
+  auto state_sub = nh_->subscribe<std_msgs::String>(
+      "/sketchnav_sim/state", 5, [&](const std_msgs::StringConstPtr& m) {
+        const Json j = Json::parse(m->data);
+        std::lock_guard<std::mutex> l(om);
+        if (j["collided"].get<bool>() && !collided) {
+          collided = true;
+          with = j["collision_with"].get<std::string>();
+        }
+      });
+  const double t0 = wallNow();
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> l(om);
+      if (collided || wallNow() - t0 > 40) break;
+    }
+    cmd_pub.publish(fwd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(collided) << "driving straight from the start hit nothing in 40 s" << logs();
+  const double hit = wallNow();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  {
+    std::lock_guard<std::mutex> l(om);
+    ASSERT_FALSE(odom_wall.empty());
+    // The state is published every 0.5 s (simulated) after the hit: odometry ended before.
+    EXPECT_LT(odom_wall.back(), hit) << "odometry still published after the collision";
+  }
+  EXPECT_NE(sim_->err().find("collision with " + with), std::string::npos) << logs();
+  sim_->signal(SIGINT);
+  ASSERT_TRUE(sim_->wait(10));
+  const Json s = Json::parse(sim_->out());
+  EXPECT_TRUE(s["collided"].get<bool>());
+  EXPECT_EQ(s["collision_with"], with);
 }
 
 // Garbage on a topic (or a frozen topic, or SIGINT): a clear log line naming the topic and

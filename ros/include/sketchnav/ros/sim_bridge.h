@@ -11,7 +11,8 @@
 //   (exact, world frame) ~state                   std_msgs/String JSON: t, collided, at_goal,
 //   distance_to_goal_m...
 // and subscribes to cmd_vel (geometry_msgs/Twist). Like a real base it stops when commands
-// stop: a command older than cmd_timeout_s (simulated) is replaced by zero.
+// stop: a command older than cmd_timeout_s (simulated) is replaced by zero. A collision stops
+// the base for good and its odometry stops (the navigation sees a lost base).
 #include <functional>
 #include <string>
 
