@@ -20,6 +20,10 @@ PACKAGES=(
   libgtest-dev libgmock-dev libbenchmark-dev
   visp-images-data mrpt-common
   chromium
+  # ROS 1 (Debian's Noetic-era core) for sketchnav::ros and `sketchnav ros` (doc/ros.md); the
+  # message headers, tf2 and cv_bridge to build it, rosmaster for its tests.
+  libroscpp-dev libcv-bridge-dev libtf2-ros-dev libstd-msgs-dev libsensor-msgs-dev
+  libnav-msgs-dev libgeometry-msgs-dev libros-rosgraph-msgs-dev librosbag-storage-dev python3-rosmaster
 )
 
 missing=()

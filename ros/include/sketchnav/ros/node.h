@@ -1,0 +1,120 @@
+#pragma once
+// The ROS 1 side of sketchnav (doc/ros.md). One process is one ROS node: init() connects it
+// to the master (ROS_MASTER_URI, ROS_IP as usual), and the ros:// devices registered by
+// registerDrivers() subscribe / publish through it:
+//   ros://camera?topic=image_raw&info=camera_info   sensor_msgs/Image (+ CameraInfo)
+//   ros://base?cmd_vel=cmd_vel&odom=odom            geometry_msgs/Twist out, nav_msgs/Odometry in
+//   ros://laser?topic=scan                          sensor_msgs/LaserScan
+//   ros://sonar?topic=sonar                         sensor_msgs/Range, one frame per transducer
+// so `sketchnav ros nav` runs the unchanged executive (nav/) on a ROS robot. Topic names are
+// relative (resolved in the node's namespace; `from:=to` remappings apply).
+//
+// SAFETY. A watchdog thread (wall clock, 100 Hz) latches a fault, publishes a zero Twist at
+// once and keeps every later command at zero when: any input is older than
+// RosParams::stale_timeout_s, an input delivered garbage (empty image, an encoding that is not
+// a colour / grey image, NaN odometry, a scan whose length does not match its angles), its
+// publisher went away, the master cannot be reached, or SIGINT / SIGTERM arrived. The ros://
+// base then reports ok() == false, so the executive stops and fails the run with that reason.
+// Nothing the node publishes moves the robot after a fault (the process ends with the route).
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/hw/clock.h"
+
+namespace sketchnav::ros {
+
+/// The node's own settings ("ros.*", as --set ros.x=... or the ROS parameter ~ros/x).
+struct RosParams {
+  double stale_timeout_s = 0.5;  // [s, wall] an input older than this stops the robot
+  double wait_s = 30.0;          // [s, wall] how long opening a device waits for its first message
+  double master_check_s = 0.25;  // [s, wall] how often the master's presence is checked
+  std::string image_topic = "image_raw";
+  std::string camera_info_topic = "camera_info";
+  std::string odom_topic = "odom";
+  std::string scan_topic = "scan";    // "" = no laser
+  std::string sonar_topic = "sonar";  // "" = no sonar
+  std::string cmd_vel_topic = "cmd_vel";
+  std::string base_frame = "base_link";
+  bool camera_mount_from_tf = true;  // servo.camera_x_m/z_m, nav.perception.camera_yaw/pitch
+                                     // from tf base_frame -> the image's frame, unless set
+  template <class B>
+  void bind(B& b) {
+    b("stale_timeout_s", stale_timeout_s);
+    b("wait_s", wait_s);
+    b("master_check_s", master_check_s);
+    b("image_topic", image_topic);
+    b("camera_info_topic", camera_info_topic);
+    b("odom_topic", odom_topic);
+    b("scan_topic", scan_topic);
+    b("sonar_topic", sonar_topic);
+    b("cmd_vel_topic", cmd_vel_topic);
+    b("base_frame", base_frame);
+    b("camera_mount_from_tf", camera_mount_from_tf);
+  }
+  void validate() const;  // InputError "ros.<field> = ...: ..."
+};
+
+/// Connects this process to the ROS master as node `name`. `args` are passed to ros::init (ROS
+/// remappings `from:=to`, `__name:=`, `__ns:=`...). Installs SIGINT / SIGTERM handlers that
+/// trip the watchdog (robot stopped) and make ok() false. Throws RuntimeError when the master
+/// cannot be reached within `wait_master_s` (wall).
+void init(const std::string& name, const std::vector<std::string>& args, double wait_master_s);
+/// False after a signal, ros::shutdown() or a lost master.
+bool ok();
+/// The signal that ended the node ("SIGINT", "SIGTERM") or "".
+std::string signalReceived();
+/// Sends what is queued and leaves the master. Idempotent.
+void shutdown();
+
+/// The node's private parameters (~) as settings: ~nav/v_cruise -> "nav.v_cruise". Keys are
+/// whatever is on the parameter server; the caller checks them (strict, like --set).
+Config privateParams();
+
+/// Starts the watchdog with these limits (once; later calls update the limits).
+void startWatchdog(const RosParams& p);
+/// The latched fault ("" while healthy), e.g. "odometry on /odom: no message for 0.52 s".
+std::string fault();
+/// Publishes one zero Twist on the ros:// base's cmd_vel (no-op before the base exists): what
+/// the navigation sends when its route starts, so `ros sim` (holding time at 0) starts too.
+void sendZeroCommand();
+/// Trips the watchdog by hand (zero Twist now, every later command zero).
+void trip(const std::string& reason);
+
+/// The ROS clock (simulated when /use_sim_time is set): now() = ros::Time::now();
+/// sleepUntil() returns early once the watchdog has tripped, so a frozen /clock cannot hang
+/// the executive.
+std::shared_ptr<hw::Clock> clock();
+/// Waits (wall) until ROS time is valid (a first /clock under use_sim_time). False on timeout.
+bool waitForTime(double timeout_s);
+
+/// Registers the ros:// camera, base and range drivers with hw::Registry. Idempotent.
+void registerDrivers();
+
+/// Where tf puts a camera's optical frame in the base frame.
+struct CameraMount {
+  double x = 0, y = 0, z = 0;  // [m]
+  double yaw = 0;              // [rad] pan, CCW
+  double pitch = 0;            // [rad] tilt, up positive
+  std::string frame;
+};
+/// Looks up tf base_frame -> camera_frame (waiting up to timeout_s wall). False when absent.
+bool lookupCameraMount(const std::string& base_frame, const std::string& camera_frame,
+                       double timeout_s, CameraMount& out);
+/// The frame_id of the next image on `topic` (waiting up to timeout_s wall); "" on timeout.
+std::string imageFrame(const std::string& topic, double timeout_s);
+
+/// A std_msgs/String topic carrying one JSON object per message (state, events, result).
+class JsonPublisher {
+ public:
+  JsonPublisher(const std::string& topic, bool latch, int queue = 50);
+  ~JsonPublisher();
+  void publish(const Json& j);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace sketchnav::ros

@@ -1,0 +1,57 @@
+#pragma once
+// State shared by the ros:// devices, the watchdog and the node helpers (one node a process).
+#include <ros/ros.h>
+#include <tf2_ros/buffer.h>
+#include <tf2_ros/transform_listener.h>
+
+#include <atomic>
+#include <functional>
+#include <memory>
+#include <mutex>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include "sketchnav/ros/node.h"
+
+namespace sketchnav::ros::detail {
+
+/// One subscribed stream the watchdog judges.
+struct Input {
+  std::string what;                     // "camera", "odometry", "laser scan", "sonar"
+  std::string topic;                    // resolved name
+  std::atomic<double> wall_last{-1.0};  // [s] wallNow() of the last message, -1 before the first
+  std::atomic<bool> had_publisher{false};
+  std::atomic<bool> active{true};             // false once its device is closing
+  std::function<std::uint32_t()> publishers;  // number of connected publishers
+};
+
+struct State {
+  std::mutex mutex;
+  bool initialised = false;
+  std::unique_ptr<::ros::NodeHandle> nh;
+  std::unique_ptr<::ros::AsyncSpinner> spinner;
+  std::shared_ptr<tf2_ros::Buffer> tf;
+  std::unique_ptr<tf2_ros::TransformListener> tf_listener;
+  std::vector<std::shared_ptr<Input>> inputs;
+  ::ros::Publisher cmd_vel;  // set by the ros:// base: what the watchdog zeroes
+  bool have_cmd_vel = false;
+  RosParams params;
+  std::string fault;
+  std::atomic<bool> tripped{false};
+  std::thread watchdog, liveness;
+  std::atomic<bool> watchdog_stop{false};
+};
+
+State& state();
+double wallNow();
+/// Publishes a zero Twist on the base's cmd_vel (no-op without a base). Never throws.
+void publishZero() noexcept;
+/// A stream delivered garbage: log it and trip the watchdog.
+void garbage(const std::string& reason);
+void addInput(const std::shared_ptr<Input>& in);
+void removeInput(const std::shared_ptr<Input>& in);
+/// Throws RuntimeError when init() has not run.
+::ros::NodeHandle& nodeHandle();
+
+}  // namespace sketchnav::ros::detail

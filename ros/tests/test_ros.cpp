@@ -1,0 +1,691 @@
+// The ROS interface end to end (doc/ros.md), on loopback only: each test starts its own
+// `rosmaster --core` on a free 127.0.0.1 port, runs `sketchnav ros sim` / `sketchnav ros nav`
+// as separate processes through it, and watches cmd_vel from this process (a ROS node too).
+// Skipped when the ROS tools (rosmaster) are not installed.
+#include <arpa/inet.h>
+#include <fcntl.h>
+#include <geometry_msgs/Twist.h>
+#include <gtest/gtest.h>
+#include <nav_msgs/Odometry.h>
+#include <netinet/in.h>
+#include <ros/ros.h>
+#include <rosgraph_msgs/Clock.h>
+#include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/Image.h>
+#include <sensor_msgs/LaserScan.h>
+#include <signal.h>
+#include <std_msgs/String.h>
+#include <sys/socket.h>
+#include <sys/wait.h>
+#include <unistd.h>
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <limits>
+#include <mutex>
+#include <sstream>
+#include <string>
+#include <thread>
+#include <vector>
+
+#include <rosbag/bag.h>
+#include <sensor_msgs/CompressedImage.h>
+#include <opencv2/imgcodecs.hpp>
+
+#include "sketchnav/core/config.h"
+#include "sketchnav/core/error.h"
+#include "sketchnav/hw/registry.h"
+#include "sketchnav/ros/bag.h"
+
+namespace fs = std::filesystem;
+using sketchnav::Json;
+
+namespace {
+
+double wallNow() {
+  using C = std::chrono::steady_clock;
+  static const C::time_point t0 = C::now();
+  return std::chrono::duration<double>(C::now() - t0).count();
+}
+
+bool haveRos() {
+  return std::system("command -v rosmaster >/dev/null 2>&1") == 0;
+}
+
+int freePort() {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = 0;
+  ::bind(s, reinterpret_cast<sockaddr*>(&a), sizeof a);
+  socklen_t n = sizeof a;
+  ::getsockname(s, reinterpret_cast<sockaddr*>(&a), &n);
+  const int port = ntohs(a.sin_port);
+  ::close(s);
+  return port;
+}
+
+bool portOpen(int port) {
+  const int s = ::socket(AF_INET, SOCK_STREAM, 0);
+  sockaddr_in a{};
+  a.sin_family = AF_INET;
+  a.sin_addr.s_addr = htonl(INADDR_LOOPBACK);
+  a.sin_port = htons(port);
+  const bool ok = ::connect(s, reinterpret_cast<sockaddr*>(&a), sizeof a) == 0;
+  ::close(s);
+  return ok;
+}
+
+std::string slurp(const std::string& path) {
+  std::ifstream f(path);
+  std::stringstream ss;
+  ss << f.rdbuf();
+  return ss.str();
+}
+
+// A child process with stdout / stderr in files; killed (SIGKILL) if still running at the end.
+class Process {
+ public:
+  Process(const std::vector<std::string>& argv, const std::string& out, const std::string& err)
+      : out_(out), err_(err) {
+    pid_ = ::fork();
+    if (pid_ == 0) {
+      const int o = ::open(out.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      const int e = ::open(err.c_str(), O_WRONLY | O_CREAT | O_TRUNC, 0644);
+      ::dup2(o, 1);
+      ::dup2(e, 2);
+      std::vector<char*> a;
+      for (const auto& s : argv) a.push_back(const_cast<char*>(s.c_str()));
+      a.push_back(nullptr);
+      ::execvp(a[0], a.data());
+      ::_exit(127);
+    }
+  }
+  ~Process() {
+    if (running()) {
+      ::kill(pid_, SIGKILL);
+      wait(5);
+    }
+  }
+  bool running() {
+    if (done_) return false;
+    int st = 0;
+    if (::waitpid(pid_, &st, WNOHANG) == pid_) {
+      done_ = true;
+      status_ = st;
+      return false;
+    }
+    return true;
+  }
+  /// Waits up to timeout_s; true when it ended.
+  bool wait(double timeout_s) {
+    const double t0 = wallNow();
+    while (running()) {
+      if (wallNow() - t0 > timeout_s) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(10));
+    }
+    return true;
+  }
+  void signal(int sig) { ::kill(pid_, sig); }
+  bool exitedNormally() const { return done_ && WIFEXITED(status_); }
+  int exitCode() const { return done_ && WIFEXITED(status_) ? WEXITSTATUS(status_) : -1; }
+  std::string out() const { return slurp(out_); }
+  std::string err() const { return slurp(err_); }
+
+ private:
+  pid_t pid_ = -1;
+  bool done_ = false;
+  int status_ = 0;
+  std::string out_, err_;
+};
+
+// The lab's sketch cut after its first landmark (about 3 m of route): a route the suite can
+// drive in seconds of simulated time.
+std::string shortLabSketch(const fs::path& dir) {
+  std::ifstream f(std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json");
+  Json s = Json::parse(f);
+  Json path = Json::array();
+  for (const auto& p : s["path"])
+    if (p[0].get<double>() <= 230) path.push_back(p);
+  Json lms = Json::array();
+  for (const auto& l : s["landmarks"])
+    if (l["id"] == "L1") lms.push_back(l);
+  s["path"] = path;
+  s["landmarks"] = lms;
+  s["goal"] = path.back();
+  s.erase("goal_place");
+  s["name"] = "lab, first 3 m (test_ros)";
+  const std::string out = (dir / "short.sketch.json").string();
+  std::ofstream(out) << s.dump(1);
+  return out;
+}
+
+// The ROS world of this test process: a master on a free loopback port and this process as
+// a node on it, made by the first test that needs it (ctest runs each test in a process of
+// its own; a direct run shares one master, as roscpp connects a process once).
+struct RosWorld {
+  fs::path dir;
+  int port = 0;
+  std::unique_ptr<Process> master;
+  std::unique_ptr<ros::NodeHandle> nh;
+  std::unique_ptr<ros::AsyncSpinner> spinner;
+  std::string error;  // why it could not be made
+};
+RosWorld& world() {
+  static RosWorld w;
+  if (w.nh || !w.error.empty()) return w;
+  w.dir = fs::temp_directory_path() / ("sketchnav-test-ros-" + std::to_string(::getpid()));
+  fs::create_directories(w.dir / "roshome");
+  w.port = freePort();
+  ::setenv("ROS_MASTER_URI", ("http://127.0.0.1:" + std::to_string(w.port)).c_str(), 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::unsetenv("ROS_HOSTNAME");
+  ::setenv("ROS_HOME", (w.dir / "roshome").c_str(), 1);
+  w.master = std::make_unique<Process>(
+      std::vector<std::string>{"rosmaster", "--core", "-p", std::to_string(w.port)},
+      (w.dir / "master.out").string(), (w.dir / "master.err").string());
+  const double t0 = wallNow();
+  while (!portOpen(w.port)) {
+    if (wallNow() - t0 > 20.0) {
+      w.error = "rosmaster did not start: " + w.master->err();
+      return w;
+    }
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  int argc = 1;
+  char name[] = "test_ros";
+  char* argv[] = {name, nullptr};
+  ros::init(argc, argv, "test_ros_observer",
+            ros::init_options::NoSigintHandler | ros::init_options::NoRosout);
+  w.nh = std::make_unique<ros::NodeHandle>();
+  w.spinner = std::make_unique<ros::AsyncSpinner>(1);
+  w.spinner->start();
+  return w;
+}
+
+class RosTest : public ::testing::Test {
+ protected:
+  void SetUp() override {
+    if (!haveRos()) GTEST_SKIP() << "ROS 1 tools (rosmaster) not installed";
+    RosWorld& w = world();
+    ASSERT_TRUE(w.error.empty()) << w.error;
+    nh_ = w.nh.get();
+    dir_ = w.dir / ::testing::UnitTest::GetInstance()->current_test_info()->name();
+    fs::create_directories(dir_);
+    // A simulator of an earlier test left simulated time on: this one starts on wall time.
+    ros::param::del("/use_sim_time");
+    cmd_sub_ = nh_->subscribe<geometry_msgs::Twist>(
+        "cmd_vel", 100, [this](const geometry_msgs::TwistConstPtr& m) {
+          std::lock_guard<std::mutex> l(m_);
+          cmds_.push_back({wallNow(), m->linear.x, m->angular.z});
+        });
+  }
+  void TearDown() override {
+    nav_.reset();
+    sim_.reset();
+    cmd_sub_.shutdown();
+    std::error_code ec;
+    if (!HasFailure()) fs::remove_all(dir_, ec);
+  }
+
+  std::vector<std::string> cmd(std::initializer_list<std::string> args) {
+    std::vector<std::string> v = {SKETCHNAV_EXE};
+    v.insert(v.end(), args.begin(), args.end());
+    return v;
+  }
+  // Started before the navigation, as a launch file would: the navigation reads /use_sim_time
+  // when it connects.
+  void startSim(const std::string& rate) {
+    sim_ = std::make_unique<Process>(
+        cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1", "--rate", rate}),
+        (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
+    ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20))
+        << "ros sim did not set /use_sim_time" << logs();
+  }
+  void startNav(const std::string& sketch, std::vector<std::string> extra = {}) {
+    auto v = cmd({"--json", "ros", "nav", "--sketch", sketch, "--exit-on-result", "--cache-dir",
+                  SKETCHNAV_MODEL_CACHE_DIR});
+    v.insert(v.end(), extra.begin(), extra.end());
+    nav_ = std::make_unique<Process>(v, (dir_ / "nav.out").string(), (dir_ / "nav.err").string());
+  }
+  struct Cmd {
+    double wall, v, w;
+  };
+  std::vector<Cmd> commands() {
+    std::lock_guard<std::mutex> l(m_);
+    return cmds_;
+  }
+  bool waitFor(const std::function<bool()>& f, double timeout_s) {
+    const double t0 = wallNow();
+    while (!f()) {
+      if (wallNow() - t0 > timeout_s) return false;
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+    }
+    return true;
+  }
+  bool moving() {
+    for (const auto& c : commands())
+      if (std::abs(c.v) > 0.05) return true;
+    return false;
+  }
+  std::string logs() {
+    return "\n--- nav stderr:\n" + (nav_ ? nav_->err() : "") + "\n--- sim stderr:\n" +
+           (sim_ ? sim_->err() : "");
+  }
+
+  fs::path dir_;
+  std::unique_ptr<Process> sim_, nav_;
+  ros::NodeHandle* nh_ = nullptr;
+  ros::Subscriber cmd_sub_;
+  std::mutex m_;
+  std::vector<Cmd> cmds_;
+};
+
+TEST_F(RosTest, SimAndNavThroughAMasterDriveTheShortLabRoute) {
+  const std::string sketch = shortLabSketch(dir_);
+  startSim("1");
+  if (HasFatalFailure()) return;
+  startNav(sketch, {"--max-time", "60"});
+  ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
+  EXPECT_EQ(nav_->exitCode(), 0) << logs();
+  const Json r = Json::parse(nav_->out());
+  EXPECT_TRUE(r["success"].get<bool>()) << r["reason"] << logs();
+  EXPECT_EQ(r["sections_done"], r["sections"]);
+  EXPECT_EQ(r["ros"]["fault"], "");
+  // L1 was recognised through the ROS camera.
+  EXPECT_NE(r["landmarks_recognised"].dump().find("L1"), std::string::npos) << r.dump(1);
+  // The simulator saw the robot drive: its ground truth, not the node's belief.
+  sim_->signal(SIGINT);
+  ASSERT_TRUE(sim_->wait(10));
+  EXPECT_EQ(sim_->exitCode(), 0) << logs();
+  const Json s = Json::parse(sim_->out());
+  EXPECT_FALSE(s["collided"].get<bool>()) << s.dump(1);
+  EXPECT_GT(s["path_length_m"].get<double>(), 2.5) << s.dump(1);
+  EXPECT_GT(s["commands_received"].get<int>(), 50);
+  // The route ends at a standstill.
+  const auto c = commands();
+  ASSERT_FALSE(c.empty());
+  EXPECT_EQ(c.back().v, 0.0);
+  EXPECT_EQ(c.back().w, 0.0);
+  std::printf(
+      "short lab route through ROS: nav time %.1f s, odometry path %.2f m, sim path %.2f m\n",
+      r["time_s"].get<double>(), r["odom_path_m"].get<double>(), s["path_length_m"].get<double>());
+}
+
+TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
+  startSim("1");
+  if (HasFatalFailure()) return;
+  startNav(std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
+           {"--max-time", "120"});
+  ASSERT_TRUE(waitFor([&] { return moving() || !nav_->running(); }, 120)) << logs();
+  ASSERT_TRUE(nav_->running()) << logs();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // cruising
+  ASSERT_TRUE(moving());
+  const double killed = wallNow();
+  sim_->signal(SIGKILL);
+  ASSERT_TRUE(sim_->wait(5));
+  // The first zero command after the kill.
+  double stop_wall = -1;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const auto& c : commands())
+          if (c.wall >= killed && c.v == 0.0 && c.w == 0.0) {
+            stop_wall = c.wall;
+            return true;
+          }
+        return false;
+      },
+      5))
+      << "no zero cmd_vel after the simulator was killed" << logs();
+  const double delay = stop_wall - killed;
+  std::printf("simulator killed -> zero cmd_vel after %.3f s\n", delay);
+  RecordProperty("stop_delay_ms", static_cast<int>(delay * 1000));
+  EXPECT_LT(delay, 0.5) << logs();
+  // No motion command after the stop, and the node ends the route as failed, saying why.
+  for (const auto& c : commands())
+    if (c.wall > stop_wall) EXPECT_TRUE(c.v == 0.0 && c.w == 0.0) << c.v << " " << c.w;
+  ASSERT_TRUE(nav_->wait(10)) << logs();
+  EXPECT_EQ(nav_->exitCode(), 1) << logs();
+  const Json r = Json::parse(nav_->out());
+  EXPECT_FALSE(r["success"].get<bool>());
+  EXPECT_NE(r["reason"].get<std::string>().find("safety stop"), std::string::npos) << r["reason"];
+  std::printf("reason: %s\n", r["reason"].get<std::string>().c_str());
+}
+
+// Driving the simulated robot into something: it collides, its base stops for good and its
+// odometry stops (what tells `ros nav` the base is lost); its ground truth says what was hit.
+TEST_F(RosTest, ACollisionInTheSimulatorStopsItsOdometry) {
+  startSim("2");
+  if (HasFatalFailure()) return;
+  std::mutex om;
+  std::vector<double> odom_wall;
+  auto odom_sub =
+      nh_->subscribe<nav_msgs::Odometry>("odom", 100, [&](const nav_msgs::OdometryConstPtr&) {
+        std::lock_guard<std::mutex> l(om);
+        odom_wall.push_back(wallNow());
+      });
+  auto cmd_pub = nh_->advertise<geometry_msgs::Twist>("cmd_vel", 5);
+  geometry_msgs::Twist fwd;
+  fwd.linear.x = 0.5;
+  // Straight ahead from the lab's start until the simulator reports a collision (or 40 s).
+  bool collided = false;
+  std::string with;
+  auto state_sub = nh_->subscribe<std_msgs::String>(
+      "/sketchnav_sim/state", 5, [&](const std_msgs::StringConstPtr& m) {
+        const Json j = Json::parse(m->data);
+        std::lock_guard<std::mutex> l(om);
+        if (j["collided"].get<bool>() && !collided) {
+          collided = true;
+          with = j["collision_with"].get<std::string>();
+        }
+      });
+  const double t0 = wallNow();
+  for (;;) {
+    {
+      std::lock_guard<std::mutex> l(om);
+      if (collided || wallNow() - t0 > 40) break;
+    }
+    cmd_pub.publish(fwd);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_TRUE(collided) << "driving straight from the start hit nothing in 40 s" << logs();
+  const double hit = wallNow();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));
+  {
+    std::lock_guard<std::mutex> l(om);
+    ASSERT_FALSE(odom_wall.empty());
+    // The state is published every 0.5 s (simulated) after the hit: odometry ended before.
+    EXPECT_LT(odom_wall.back(), hit) << "odometry still published after the collision";
+  }
+  EXPECT_NE(sim_->err().find("collision with " + with), std::string::npos) << logs();
+  sim_->signal(SIGINT);
+  ASSERT_TRUE(sim_->wait(10));
+  const Json s = Json::parse(sim_->out());
+  EXPECT_TRUE(s["collided"].get<bool>());
+  EXPECT_EQ(s["collision_with"], with);
+}
+
+// Garbage on a topic (or a frozen topic, or SIGINT): a clear log line naming the topic and
+// the problem, a stop, no crash.
+struct Garbage {
+  const char* name;
+  const char* expect;             // in the node's stderr
+  const char* also_ok = nullptr;  // or this (two supervisors may see it first)
+};
+void PrintTo(const Garbage& g, std::ostream* os) {
+  *os << g.name;
+}
+class RosGarbage : public RosTest, public ::testing::WithParamInterface<Garbage> {};
+
+TEST_P(RosGarbage, StopsWithAClearLogLine) {
+  const Garbage g = GetParam();
+  // This process is the robot: wall time (no /clock), a camera, odometry and a laser whose
+  // frames are the base frame (no tf needed), 20 Hz.
+  auto img_pub = nh_->advertise<sensor_msgs::Image>("image_raw", 2);
+  auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
+  auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
+  auto scan_pub = nh_->advertise<sensor_msgs::LaserScan>("scan", 5);
+  std::atomic<bool> stop{false}, bad{false};
+  std::thread robot([&] {
+    while (!stop) {
+      const ros::Time now = ros::Time::now();
+      const bool b = bad;
+      sensor_msgs::Image im;
+      im.header.stamp = now;
+      im.header.frame_id = "base_link";
+      im.width = 64;
+      im.height = 48;
+      im.encoding = "bgr8";
+      im.step = 64 * 3;
+      im.data.assign(64 * 48 * 3, 90);
+      if (b && std::string(g.name) == "empty_image") {
+        im.width = im.height = im.step = 0;
+        im.data.clear();
+      }
+      if (b && std::string(g.name) == "wrong_encoding") {
+        im.encoding = "32FC1";
+        im.step = 64 * 4;
+        im.data.assign(64 * 48 * 4, 0);
+      }
+      if (!(b && std::string(g.name) == "frozen_camera")) img_pub.publish(im);
+      sensor_msgs::CameraInfo ci;
+      ci.header = im.header;
+      ci.width = 64;
+      ci.height = 48;
+      ci.K = {55, 0, 31.5, 0, 55, 23.5, 0, 0, 1};
+      info_pub.publish(ci);
+      nav_msgs::Odometry od;
+      od.header.stamp = now;
+      od.pose.pose.orientation.w = 1;
+      if (b && std::string(g.name) == "nan_odometry")
+        od.pose.pose.position.x = std::numeric_limits<double>::quiet_NaN();
+      odom_pub.publish(od);
+      sensor_msgs::LaserScan sc;
+      sc.header.stamp = now;
+      sc.header.frame_id = "base_link";
+      sc.angle_min = -1.0f;
+      sc.angle_max = 1.0f;
+      sc.angle_increment = 0.01f;
+      sc.range_min = 0.05f;
+      sc.range_max = 8.0f;
+      sc.ranges.assign(201, 5.0f);
+      if (b && std::string(g.name) == "scan_wrong_length") sc.ranges.resize(50);
+      scan_pub.publish(sc);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set",
+                                  "ros.camera_mount_from_tf=false", "--max-time", "60"});
+  // Running: the route has started (its first commands).
+  const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
+  bool ran = nav_->running();
+  if (started && ran) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    if (std::string(g.name) == "sigint")
+      nav_->signal(SIGINT);
+    else
+      bad = true;
+    ran = nav_->wait(10);
+  }
+  stop = true;
+  robot.join();
+  ASSERT_TRUE(started) << logs();
+  ASSERT_TRUE(ran) << "ros nav did not end after the garbage" << logs();
+  EXPECT_TRUE(nav_->exitedNormally()) << "ros nav crashed" << logs();
+  EXPECT_EQ(nav_->exitCode(), 1) << logs();
+  const std::string err = nav_->err();
+  EXPECT_NE(err.find("safety stop"), std::string::npos) << logs();
+  EXPECT_TRUE(err.find(g.expect) != std::string::npos ||
+              (g.also_ok && err.find(g.also_ok) != std::string::npos))
+      << logs();
+  const auto c = commands();
+  ASSERT_FALSE(c.empty());
+  EXPECT_EQ(c.back().v, 0.0);
+  EXPECT_EQ(c.back().w, 0.0);
+}
+
+INSTANTIATE_TEST_SUITE_P(
+    Topics, RosGarbage,
+    ::testing::Values(Garbage{"empty_image", "camera on /image_raw: empty image"},
+                      Garbage{"wrong_encoding", "encoding '32FC1'"},
+                      Garbage{"nan_odometry", "odometry on /odom: NaN"},
+                      Garbage{"scan_wrong_length", "the scan has 50 ranges"},
+                      Garbage{"frozen_camera", "camera on /image_raw: no message for",
+                              // the executive's own check on ROS time, same 0.5 s limit
+                              "safety stop: camera stale: no data for"},
+                      Garbage{"sigint", "SIGINT received"}),
+    [](const ::testing::TestParamInfo<Garbage>& i) { return std::string(i.param.name); });
+
+TEST(RosCli, UnknownRosParameterIsRefused) {
+  if (!haveRos()) GTEST_SKIP() << "ROS 1 tools (rosmaster) not installed";
+  // Checked before any device is opened: no master needed beyond the node's start.
+  const int port = freePort();
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-cli-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  ::setenv("ROS_MASTER_URI", ("http://127.0.0.1:" + std::to_string(port)).c_str(), 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::setenv("ROS_HOME", dir.c_str(), 1);
+  Process master({"rosmaster", "--core", "-p", std::to_string(port)}, (dir / "m.out").string(),
+                 (dir / "m.err").string());
+  const double t0 = wallNow();
+  while (!portOpen(port)) {
+    ASSERT_LT(wallNow() - t0, 20.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  Process nav({SKETCHNAV_EXE, "ros", "nav", "--sketch",
+               std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
+               "--exit-on-result", "_nav/v_crusie:=0.2"},
+              (dir / "n.out").string(), (dir / "n.err").string());
+  ASSERT_TRUE(nav.wait(30));
+  EXPECT_EQ(nav.exitCode(), 2) << nav.err();
+  EXPECT_NE(nav.err().find("nav.v_crusie"), std::string::npos) << nav.err();
+  fs::remove_all(dir);
+}
+
+// The master goes away mid-route: the node stops and fails the route saying so. Its own
+// master (not the shared one: this test kills it), observed through the node's result.
+TEST(RosMaster, LosingTheMasterStopsTheRoute) {
+  if (!haveRos()) GTEST_SKIP() << "ROS 1 tools (rosmaster) not installed";
+  const int port = freePort();
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-master-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string uri = "http://127.0.0.1:" + std::to_string(port);
+  const std::string saved = std::getenv("ROS_MASTER_URI") ? std::getenv("ROS_MASTER_URI") : "";
+  ::setenv("ROS_MASTER_URI", uri.c_str(), 1);
+  ::setenv("ROS_IP", "127.0.0.1", 1);
+  ::setenv("ROS_HOME", dir.c_str(), 1);
+  auto master = std::make_unique<Process>(
+      std::vector<std::string>{"rosmaster", "--core", "-p", std::to_string(port)},
+      (dir / "m.out").string(), (dir / "m.err").string());
+  const double t0 = wallNow();
+  while (!portOpen(port)) {
+    ASSERT_LT(wallNow() - t0, 20.0);
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  Process sim({SKETCHNAV_EXE, "ros", "sim", "--world", "lab", "--seed", "1"},
+              (dir / "s.out").string(), (dir / "s.err").string());
+  std::this_thread::sleep_for(std::chrono::milliseconds(1500));  // /use_sim_time set
+  Process nav({SKETCHNAV_EXE, "--json", "ros", "nav", "--sketch",
+               std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
+               "--exit-on-result", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR},
+              (dir / "n.out").string(), (dir / "n.err").string());
+  // Until the route runs ("start" is logged when it begins).
+  const double t1 = wallNow();
+  while (nav.running() && nav.err().find("start: ") == std::string::npos && wallNow() - t1 < 120)
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  ASSERT_TRUE(nav.running()) << nav.err();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  master->signal(SIGKILL);
+  const double killed = wallNow();
+  ASSERT_TRUE(nav.wait(10)) << nav.err();
+  const double ended = wallNow() - killed;
+  EXPECT_EQ(nav.exitCode(), 1) << nav.err();
+  const Json r = Json::parse(nav.out());
+  EXPECT_FALSE(r["success"].get<bool>());
+  EXPECT_NE(r["reason"].get<std::string>().find("ROS master at " + uri + " cannot be reached"),
+            std::string::npos)
+      << r["reason"];
+  std::printf("master killed -> route ended after %.2f s: %s\n", ended,
+              r["reason"].get<std::string>().c_str());
+  sim.signal(SIGKILL);
+  if (!saved.empty()) ::setenv("ROS_MASTER_URI", saved.c_str(), 1);
+  fs::remove_all(dir);
+}
+
+// bag:// camera: frames in bag order with stamps relative to the first, a compressed frame
+// decoded, a broken frame skipped and counted, camera_info as intrinsics, then the end.
+TEST(RosBag, CameraReadsImagesFromABag) {
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-bag-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string file = (dir / "cam.bag").string();
+  {
+    rosbag::Bag bag(file, rosbag::bagmode::Write);
+    auto image = [](double t, int level) {
+      sensor_msgs::Image im;
+      im.header.stamp = ros::Time(100.0 + t);
+      im.header.frame_id = "camera_optical";
+      im.width = 32;
+      im.height = 24;
+      im.encoding = "bgr8";
+      im.step = 32 * 3;
+      im.data.assign(32 * 24 * 3, static_cast<std::uint8_t>(level));
+      return im;
+    };
+    sensor_msgs::CameraInfo ci;
+    ci.header.stamp = ros::Time(100.0);
+    ci.width = 32;
+    ci.height = 24;
+    ci.K = {30, 0, 15.5, 0, 31, 11.5, 0, 0, 1};
+    bag.write("/cam/camera_info", ros::Time(100.0), ci);
+    bag.write("/cam/image_raw", ros::Time(100.0), image(0.0, 10));
+    bag.write("/cam/image_raw", ros::Time(100.1), image(0.1, 20));
+    sensor_msgs::Image broken = image(0.2, 30);
+    broken.data.resize(10);
+    bag.write("/cam/image_raw", ros::Time(100.2), broken);
+    sensor_msgs::Image mono = image(0.3, 0);
+    mono.encoding = "mono8";
+    mono.step = 32;
+    mono.data.assign(32 * 24, 40);
+    bag.write("/cam/image_raw", ros::Time(100.3), mono);
+    bag.write("/other/image_raw", ros::Time(100.3), image(0.3, 99));
+    sensor_msgs::CompressedImage jpg;
+    jpg.header.stamp = ros::Time(100.4);
+    jpg.format = "jpeg";
+    cv::imencode(".jpg", cv::Mat(24, 32, CV_8UC3, cv::Scalar(50, 50, 50)), jpg.data);
+    bag.write("/cam/image_raw/compressed", ros::Time(100.4), jpg);
+    bag.close();
+  }
+  sketchnav::ros::registerBagDriver();
+  sketchnav::hw::DeviceContext ctx;
+  auto& reg = sketchnav::hw::Registry::instance();
+  // Two image topics: the camera must be told which.
+  try {
+    reg.createCamera("bag://" + file, ctx);
+    FAIL() << "a bag with two image topics opened without ?topic=";
+  } catch (const sketchnav::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("several image topics"), std::string::npos) << e.what();
+  }
+  EXPECT_THROW(reg.createCamera("bag://" + file + "?topic=/nope", ctx), sketchnav::InputError);
+  EXPECT_THROW(reg.createCamera("bag:///no/such.bag", ctx), sketchnav::InputError);
+  auto cam = reg.createCamera("bag://" + file + "?topic=/cam/image_raw", ctx);
+  const auto K = cam->intrinsics();
+  EXPECT_EQ(K.width, 32);
+  EXPECT_DOUBLE_EQ(K.fx, 30);
+  EXPECT_DOUBLE_EQ(K.fy, 31);
+  std::vector<double> stamps;
+  std::vector<int> levels;
+  sketchnav::hw::Frame f;
+  while (cam->grab(f, 0.1) == sketchnav::hw::GrabStatus::Ok) {
+    ASSERT_EQ(f.image.type(), CV_8UC3);
+    stamps.push_back(f.stamp);
+    levels.push_back(f.image.at<cv::Vec3b>(5, 5)[0]);
+  }
+  ASSERT_EQ(stamps.size(), 3u);
+  EXPECT_NEAR(stamps[0], 0.0, 1e-6);
+  EXPECT_NEAR(stamps[1], 0.1, 1e-6);
+  EXPECT_NEAR(stamps[2], 0.3, 1e-6);
+  EXPECT_EQ(levels[0], 10);
+  EXPECT_EQ(levels[1], 20);
+  EXPECT_EQ(levels[2], 40);             // mono8 -> bgr8
+  EXPECT_EQ(cam->stats().dropped, 1u);  // the truncated one
+  EXPECT_EQ(cam->stats().received, 3u);
+  EXPECT_EQ(cam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
+  // A compressed image topic; no camera_info beside it: intrinsics from the 60 deg default.
+  auto jcam = reg.createCamera("bag://" + file + "?topic=/cam/image_raw/compressed", ctx);
+  ASSERT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::Ok);
+  EXPECT_EQ(f.image.cols, 32);
+  EXPECT_NEAR(f.image.at<cv::Vec3b>(5, 5)[0], 50, 3);
+  EXPECT_NEAR(jcam->intrinsics().fx, 16 / std::tan(M_PI / 6), 0.1);
+  EXPECT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
+  fs::remove_all(dir);
+}
+
+}  // namespace
