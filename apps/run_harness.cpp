@@ -593,7 +593,9 @@ Json runNavigation(const RunOptions& o) {
                      {"max_ms", es.perception_ms_max},
                      {"objectness_ms", es.objectness_ms_mean},
                      {"features_ms", es.features_ms_mean},
-                     {"match_ms", es.match_ms_mean}};
+                     {"match_ms", es.match_ms_mean},
+                     {"full_passes", es.full_passes},
+                     {"tracked_detections", es.tracked_detections}};
   s["executive"] = {{"status", nav::toString(es.status)}, {"reason", es.reason}};
   // Every setting the run used, as --config takes them (the simulator's as it ran: its seed is
   // the run's --seed).

@@ -116,6 +116,8 @@ json ExecutiveSummary::toJson() const {
           {"objectness_ms_mean", objectness_ms_mean},
           {"features_ms_mean", features_ms_mean},
           {"match_ms_mean", match_ms_mean},
+          {"full_passes", full_passes},
+          {"tracked_detections", tracked_detections},
           {"avoidance_manoeuvres", avoidance_manoeuvres},
           {"recoveries", recoveries},
           {"detours", detours},
@@ -185,6 +187,7 @@ struct Executive::Impl {
   double frame_stamp = -1e300;
   int frames = 0, processed = 0, manoeuvres = 0, missed_in_row = 0;
   double perc_sum = 0, perc_max = 0, objn_sum = 0, feat_sum = 0, match_sum = 0;
+  int full_passes = 0, tracked_detections = 0;
   std::vector<std::vector<LmTrack>> tracks;  // per section, per expected landmark
   servo::TurnCommand servo_cmd;
   double servo_t = -1e300, servo_bearing = 0;
@@ -511,6 +514,8 @@ struct Executive::Impl {
       }
       ++processed;
       perc_sum += ob.timing.total_ms;
+      full_passes += ob.timing.full_pass ? 1 : 0;
+      tracked_detections += ob.timing.tracked;
       perc_max = std::max(perc_max, ob.timing.total_ms);
       objn_sum += ob.timing.objectness_ms;
       feat_sum += ob.timing.features_ms;
@@ -1335,6 +1340,8 @@ ExecutiveSummary Executive::summary() const {
     s.match_ms_mean = I.match_sum / I.processed;
   }
   s.perception_ms_max = I.perc_max;
+  s.full_passes = I.full_passes;
+  s.tracked_detections = I.tracked_detections;
   s.avoidance_manoeuvres = I.manoeuvres;
   s.recoveries = I.recoveries;
   s.detours = I.detours;

@@ -246,6 +246,8 @@ struct ExecutiveSummary {
   int frames_processed = 0;  // frames given to perception
   double perception_ms_mean = 0, perception_ms_max = 0;
   double objectness_ms_mean = 0, features_ms_mean = 0, match_ms_mean = 0;
+  int full_passes = 0;          // processed frames on which perception's full pass ran
+  int tracked_detections = 0;   // detections the tracker supplied (PerceptionTiming::tracked)
   int avoidance_manoeuvres = 0;
   int recoveries = 0;  // stuck recoveries
   int detours = 0;     // detours planned round obstacles (local_planner.h)
