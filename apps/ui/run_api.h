@@ -61,7 +61,7 @@ struct RunRequest {
 /// How a runner reports to the page. All are set by RunController and called on the run's
 /// thread.
 struct RunHooks {
-  std::function<void(const Json&)> on_event;              // executive events
+  std::function<void(const nav::NavEvent&)> on_event;     // executive events
   std::function<void(const nav::TelemetryRow&)> on_tick;  // every control tick
   std::function<void(const hw::Frame&, const nav::Observation&)> on_observation;
   std::function<std::unique_ptr<hw::Camera>(std::unique_ptr<hw::Camera>)> wrap_camera;
