@@ -6,6 +6,7 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/nav/goal_checker.h"
 
 namespace sketchnav::nav {
 
@@ -158,6 +159,7 @@ struct LmTrack {
 
 struct Executive::Impl {
   SectionTracker tracker;
+  GoalChecker goal_checker;
   Devices dev;
   Perception& perception;
   NavSettings s;
@@ -229,6 +231,7 @@ struct Executive::Impl {
 
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
+        goal_checker(st.sections.goal_radius_m),
         dev(d),
         perception(p),
         s(st),
@@ -258,7 +261,16 @@ struct Executive::Impl {
     if (obs) obs->onEvent(NavEvent{now - t0, std::move(d)});
   }
   void succeed(const std::string& why) { finish(RunStatus::Succeeded, FailureCode::None, why); }
-  void fail(FailureCode code, const std::string& why) { finish(RunStatus::Failed, code, why); }
+  // A failure rule about the way to the goal cannot fire once the goal is reached
+  // (GoalChecker): the run goes on and ends as it does at the goal.
+  void fail(FailureCode code, const std::string& why) {
+    if (status == RunStatus::Running && have_pose && GoalChecker::overrules(code) &&
+        goal_checker.reached(tracker, pose)) {
+      log::info("nav", "at the goal: not failing for the way there", {{"rule", why}});
+      return;
+    }
+    finish(RunStatus::Failed, code, why);
+  }
   void finish(RunStatus st, FailureCode code, const std::string& why) {
     dev.base->stop();
     if (status != RunStatus::Running) return;

@@ -11,6 +11,7 @@
 #include "fake_world.h"
 #include "route_util.h"
 #include "sketchnav/nav/executive.h"
+#include "sketchnav/nav/goal_checker.h"
 
 using namespace sketchnav;
 using namespace sketchnav::nav;
@@ -100,6 +101,10 @@ TEST(Executive, ReachesTheEndWithOneLandmarkMissing) {
 
 TEST(Executive, FailsWithAReasonWhenLandmarksKeepMissing) {
   Scenario s(false, false);
+  // The route goes on 4 m past B: the second miss is on the way, not at the goal (where
+  // reaching the goal overrules the lost rule, ALandmarkNotFoundAtTheGoalDoesNotFailTheRun).
+  s.route = makeRoute({{0, 0}, {6, 0}, {6, 5}, {6, 9}},
+                      {{0, "A", "cup", {7.0, 0.3}}, {1, "B", "bin", {6.4, 6.2}}});
   s.settings.exec.max_missed_in_row = 1;
   const auto sum = s.run();
   EXPECT_EQ(sum.status, RunStatus::Failed);
@@ -202,6 +207,59 @@ TEST(Executive, WithoutTheFinalLookTheLastLandmarkIsMissed) {
   EXPECT_EQ(s.rec.count("final_look_start"), 0);
   ASSERT_EQ(sum.landmarks.size(), 3u);
   EXPECT_NE(sum.landmarks[2].state, "passed");
+}
+
+TEST(Executive, ALandmarkNotFoundAtTheGoalDoesNotFailTheRun) {
+  // C is never seen (not even in the final look at the goal) and no miss is allowed: the lost
+  // rule fires during the final look, with the robot at its goal. Reaching the goal overrules
+  // it (GoalChecker): the run arrives. (Issue 25: a run 0.16 m from its goal was reported
+  // failed, "lost: 3 landmarks in a row not found", fired during the final look.)
+  Scenario s;
+  lookBesideTheGoal(s);
+  s.perception = std::make_unique<GeometricPerception>(
+      s.world, std::vector<TrueMark>{{"cup", {7.3, 0.5}}, {"bin", {6.6, 6.5}}});
+  s.settings.exec.max_missed_in_row = 0;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_EQ(sum.failure, FailureCode::None);
+  ASSERT_EQ(s.rec.count("final_look_end"), 1);
+  for (const auto& e : s.rec.events)
+    if (const auto* x = e.as<event::FinalLookEnd>()) EXPECT_FALSE(x->seen);
+  EXPECT_EQ(s.rec.count("landmark_missed"), 1);
+  EXPECT_EQ(s.rec.count("failed"), 0);
+  ASSERT_EQ(sum.landmarks.size(), 3u);
+  EXPECT_EQ(sum.landmarks[2].state, "missed");
+  EXPECT_LT(std::hypot(s.world.truth.x - 6, s.world.truth.y - 5), 0.6);
+}
+
+TEST(Executive, TheLostRuleStillFailsARunOnTheWay) {
+  // The same rule away from the goal: A is not seen, no miss allowed.
+  Scenario s(/*see_a=*/false, /*see_b=*/true);
+  s.settings.exec.max_missed_in_row = 0;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Failed);
+  EXPECT_EQ(sum.failure, FailureCode::Lost);
+  EXPECT_EQ(sum.reason.rfind("lost: 1 landmarks in a row not found (A)", 0), 0u) << sum.reason;
+  EXPECT_EQ(s.rec.count("failed"), 1);
+  for (const auto& e : s.rec.events)
+    if (const auto* x = e.as<event::Failed>()) EXPECT_EQ(x->code, FailureCode::Lost);
+}
+
+TEST(GoalChecker, ReachedOnlyOnTheLastSectionWithinItsRadiusOrWhenFinished) {
+  SectionTracker tr(makeRoute({{0, 0}, {6, 0}, {6, 5}}), SectionParams{});
+  const GoalChecker goal(0.15);
+  EXPECT_FALSE(goal.reached(tr, {6, 4.9, M_PI / 2}));  // still on the first section
+  tr.advance();
+  EXPECT_TRUE(goal.reached(tr, {6, 4.9, M_PI / 2}));
+  EXPECT_FALSE(goal.reached(tr, {6, 4.7, M_PI / 2}));
+  EXPECT_FALSE(goal.reached(tr, {3, 0, 0}));
+  tr.advance();
+  ASSERT_TRUE(tr.finished());
+  EXPECT_TRUE(goal.reached(tr, {3, 0, 0}));
+  EXPECT_TRUE(GoalChecker::overrules(FailureCode::Lost));
+  for (auto c : {FailureCode::SafetyStop, FailureCode::Timeout, FailureCode::NoProgress,
+                 FailureCode::Stopped})
+    EXPECT_FALSE(GoalChecker::overrules(c)) << toString(c);
 }
 
 TEST(NavEvent, WritesTheEventsJsonlFormat) {
