@@ -104,8 +104,11 @@ class RunController {
 
   /// Starts a run on the background thread. InputError when one is already going.
   void start(const RunRequest& request);
-  /// Stops the base at once (real robot: from this thread; simulator: at its next command),
-  /// then the run ends with "stopped by user". Returns false when no run was going.
+  /// Stops the base at once (real robot: hw::Base::stop() on the calling thread, the HTTP
+  /// server's, serialised with the run thread's calls by StoppableBase's mutex; simulator: at
+  /// its next command, on the run thread), then the run ends with "stopped by user" (the
+  /// executive polls RunHooks::stop_requested between ticks; it is never called from this
+  /// thread). Returns false when no run was going. Thread-safe.
   bool stop();
   /// Waits for the run thread to finish (tests, shutdown).
   void join();

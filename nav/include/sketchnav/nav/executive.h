@@ -277,6 +277,11 @@ struct Devices {
   hw::Clock* clock = nullptr;
 };
 
+/// Not thread-safe: start(), step(), stop(), run() and summary() from one thread (the one that
+/// drives it, which is also the one the observer and the devices are called on). To stop a run
+/// from another thread, set a flag that the driving thread polls between step()s and calls
+/// stop() on (RunOptions::stop_requested), and stop the base itself through a wrapper that
+/// serialises with the driving thread (the run page's StoppableBase, hw/devices.h "Threads").
 class Executive {
  public:
   /// Configure. Throws InputError for invalid settings or an empty route.
