@@ -7,6 +7,7 @@
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/nav/goal_checker.h"
+#include "sketchnav/nav/progress_checker.h"
 
 namespace sketchnav::nav {
 
@@ -196,8 +197,7 @@ struct Executive::Impl {
   double last_perception_t = -1e300;
   bool sectionBlocked_ = false;
   // Stuck recovery: where the robot was stuck_s ago, and an escape under way.
-  hw::Pose2D stuck_ref;
-  double stuck_t = 0;
+  ProgressChecker progress_checker;
   bool recovering = false;
   double rec_dir = 0, rec_t0 = 0;  // escape heading (odometry frame), start time
   hw::Pose2D rec_from;
@@ -217,7 +217,7 @@ struct Executive::Impl {
   bool fl_done = false;
   bool final_looking = false;  // this tick
   int detours = 0;
-  double goal_best_ = 1e300, goal_best_t_ = 0;           // closest to the goal so far, and when
+  SettleChecker settle_checker;
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
   std::vector<Eigen::Vector2d> fixes_route, fixes_odom;  // every fix, the start first
   std::vector<std::string> fixes_class;                  // class of each ("" for the start)
@@ -232,6 +232,8 @@ struct Executive::Impl {
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
         goal_checker(st.sections.goal_radius_m),
+        progress_checker(st.exec.stuck_s, st.exec.stuck_m),
+        settle_checker(st.exec.goal_settle_m, st.exec.goal_settle_s),
         dev(d),
         perception(p),
         s(st),
@@ -714,10 +716,8 @@ struct Executive::Impl {
     // behind an obstacle the dodge went round the wrong way), turning on the spot. Not having
     // moved stuck_m in stuck_s, the robot drives recover_m towards the most open direction
     // (ties to the route side), then resumes.
-    if (!recovering && !docking && !dev.ranges.empty() && now - stuck_t >= s.exec.stuck_s) {
-      const bool stuck = std::hypot(pose.x - stuck_ref.x, pose.y - stuck_ref.y) < s.exec.stuck_m;
-      stuck_ref = pose;
-      stuck_t = now;
+    if (!recovering && !docking && !dev.ranges.empty() && progress_checker.due(now)) {
+      const bool stuck = progress_checker.stuck(pose, now);
       if (stuck) {
         const auto pts = scanPoints(scans);
         const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
@@ -752,8 +752,7 @@ struct Executive::Impl {
       if (std::hypot(pose.x - rec_from.x, pose.y - rec_from.y) >= s.exec.recover_m ||
           now - rec_t0 > s.exec.recover_s || blocked) {
         recovering = false;
-        stuck_ref = pose;
-        stuck_t = now;
+        progress_checker.reset(pose, now);
         event(event::RecoverEnd{});
       }
     }
@@ -834,18 +833,11 @@ struct Executive::Impl {
     }
     // Near the goal but no longer getting closer (the estimate sits where the robot cannot
     // stand, e.g. against a door frame): the best it can do is where it is.
-    bool goal_settled = false;
-    if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.goal_settle_m) {
-      if (prog.to_end_m < goal_best_ - 0.05) goal_best_ = prog.to_end_m, goal_best_t_ = now;
-      // A final look turns on the spot by design, and the landmark it finds moves the goal:
-      // the clock starts again when it ends. (Counted, it settled an exp2-redrawn-d robot
-      // 0.21 m short of its estimate, driving towards it at 0.1 m/s.)
-      if (final_looking) goal_best_ = prog.to_end_m, goal_best_t_ = now;
-      goal_settled = now - goal_best_t_ > s.exec.goal_settle_s;
-    } else {
-      goal_best_ = 1e300;
-      goal_best_t_ = now;
-    }
+    // A final look turns on the spot by design, and the landmark it finds moves the goal: the
+    // clock starts again when it ends. (Counted, it settled an exp2-redrawn-d robot 0.21 m
+    // short of its estimate, driving towards it at 0.1 m/s.)
+    const bool goal_settled =
+        settle_checker.update(k + 1 == tracker.count(), prog.to_end_m, now, final_looking);
     // (No final look from here: a robot settled short of the goal is usually beside furniture,
     // and the looks taken from there fixed L7 by laser ranges to the bench under it, 0.6-0.9 m
     // off, which moved the goal the wrong way: 2 of 52 experiment trials lost.)
@@ -1230,7 +1222,7 @@ void Executive::start() {
   I.t0 = I.now = I.dev.clock->now();
   I.next_tick = I.t0;
   I.section_t0 = I.t0;
-  I.stuck_t = I.t0;
+  I.progress_checker.reset(hw::Pose2D{}, I.t0);
   I.fix_route = I.tracker.route().start_m;
   I.fix_odom = I.tracker.toOdom(I.fix_route);
   I.fixes_route = {I.fix_route};

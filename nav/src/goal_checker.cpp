@@ -12,3 +12,18 @@ bool GoalChecker::overrules(FailureCode code) {
 }
 
 }  // namespace sketchnav::nav
+
+namespace sketchnav::nav {
+
+bool SettleChecker::update(bool last_section, double to_end_m, double now, bool restart) {
+  if (!(last_section && to_end_m <= near_m_)) {
+    best_m_ = 1e300;
+    best_t_ = now;
+    return false;
+  }
+  if (to_end_m < best_m_ - min_gain_m_) best_m_ = to_end_m, best_t_ = now;
+  if (restart) best_m_ = to_end_m, best_t_ = now;
+  return now - best_t_ > settle_s_;
+}
+
+}  // namespace sketchnav::nav
