@@ -6,6 +6,7 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/nav/command_arbiter.h"
 #include "sketchnav/nav/goal_checker.h"
 #include "sketchnav/nav/progress_checker.h"
 
@@ -630,19 +631,17 @@ struct Executive::Impl {
     if (status != RunStatus::Running) return;
 
     // --- command -------------------------------------------------------------------------
-    double v, w, target_bearing;
-    Mode mode = Mode::Follow;
-    servo::Turn turn = servo::Turn::Straight;
+    // Each behaviour that applies proposes a command; the arbiter's priority list decides
+    // (command_arbiter.h). The proposals below come lowest priority first.
+    CommandArbiter arb;
+    double target_bearing;
     bool looking = false;
     const bool servoing =
         tr && tr->state == LmState::Tracking && now - servo_t <= s.exec.servo_hold_s;
     if (servoing) {
-      v = servo_cmd.v;
-      w = servo_cmd.w;
       target_bearing = servo_bearing;
       servo_error = servo_cmd.error;
-      turn = servo_cmd.state;
-      mode = Mode::Servo;
+      arb.propose(Behaviour::Servo, {servo_cmd.v, servo_cmd.w, servo_cmd.state});
     } else {
       const Polar la = polarFrom(pose, tracker.lookahead(pose));
       target_bearing = la.bearing;
@@ -654,9 +653,10 @@ struct Executive::Impl {
         target_bearing = std::clamp(target_bearing, pred.bearing - m, pred.bearing + m);
         looking = target_bearing != la.bearing;
       }
-      headFor(target_bearing, 1.0, v, w);
-      turn = turnOf(target_bearing);
-      if (looking) mode = Mode::Look;
+      Command c;
+      headFor(target_bearing, 1.0, c.v, c.w);
+      c.turn = turnOf(target_bearing);
+      arb.propose(looking ? Behaviour::Look : Behaviour::Follow, c);
     }
     // Side of the next landmark, for the avoidance's rotation direction.
     // When the robot is already at the attended landmark, the obstacle is most likely the
@@ -707,9 +707,10 @@ struct Executive::Impl {
           event(event::AvoidEnd{DodgeSide::None, true});
         }
         target_bearing = bearing;
-        headFor(bearing, std::clamp(left / 0.6, 0.3, 1.0), v, w);  // slow in the last 0.6 m
-        mode = Mode::Dock;
-        turn = turnOf(bearing);
+        Command c;
+        headFor(bearing, std::clamp(left / 0.6, 0.3, 1.0), c.v, c.w);  // slow in the last 0.6 m
+        c.turn = turnOf(bearing);
+        arb.propose(Behaviour::Dock, c);
       }
     }
     // Stuck recovery: the reactive layers can livelock (boxed in between furniture, the route
@@ -744,10 +745,9 @@ struct Executive::Impl {
     }
     if (recovering) {
       const double a = wrapAngle(rec_dir - pose.theta);
-      w = std::clamp(s.avoid.k_heading * a, -s.exec.max_w, s.exec.max_w);
-      v = std::abs(a) > 0.35 ? 0.0 : avoider.capSpeed(scans, 0.7 * s.exec.v_cruise);
-      mode = Mode::Recover;
-      turn = turnOf(w);
+      const double w = std::clamp(s.avoid.k_heading * a, -s.exec.max_w, s.exec.max_w);
+      const double v = std::abs(a) > 0.35 ? 0.0 : avoider.capSpeed(scans, 0.7 * s.exec.v_cruise);
+      arb.propose(Behaviour::Recover, {v, w, turnOf(w)});
       const bool blocked = std::abs(a) <= 0.35 && v <= 0;
       if (std::hypot(pose.x - rec_from.x, pose.y - rec_from.y) >= s.exec.recover_m ||
           now - rec_t0 > s.exec.recover_s || blocked) {
@@ -759,7 +759,7 @@ struct Executive::Impl {
     double front = 0;
     bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
     if (docking || recovering) {
-      if (docking) v = avoider.capSpeed(scans, v);
+      if (docking) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
     } else if (!dev.ranges.empty()) {
       avoider.setPose(pose);
       for (const auto& m : movers.walkers()) avoider.offerWalker(m.position, m.velocity);
@@ -802,18 +802,17 @@ struct Executive::Impl {
             ++detours;
             event(event::DetourStart{detour.length_m, detour.goal, detour.goal_moved, k});
           }
-          headFor(b, 1.0, v, w);
-          v = avoider.capSpeed(scans, v);
-          mode = Mode::Detour;
+          Command c;
+          headFor(b, 1.0, c.v, c.w);
+          c.v = avoider.capSpeed(scans, c.v);
+          c.turn = turnOf(c.w);
+          arb.propose(Behaviour::Detour, c);
         } else {
           endDetour();
-          v = av.v;
-          w = av.w;
-          mode = Mode::Avoid;
+          arb.propose(Behaviour::Avoid, {av.v, av.w, turnOf(av.w)});
         }
-        turn = turnOf(w);
       } else {
-        v = avoider.capSpeed(scans, v);
+        arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
       }
     }
     // An end point that cannot be reached (the sketch put it in or against an obstacle): when
@@ -865,22 +864,25 @@ struct Executive::Impl {
     // Walking people: keep out of their lanes (movers.h). In one: step out sideways (backing
     // only slowly and with room behind); about to enter one: wait, turning is harmless.
     if (s.movers.enabled && !dev.ranges.empty() && status == RunStatus::Running) {
-      const auto adv = movers.advise(pose, v, w, s.exec.k_heading, s.exec.v_cruise);
+      // It advises on the command that would drive otherwise, and may keep its yaw rate.
+      const Command cur = arb.winner();
+      const auto adv = movers.advise(pose, cur.v, cur.w, s.exec.k_heading, s.exec.v_cruise);
       if (adv.active) {
+        Command c = cur;
         if (!adv.in_lane) {
-          v = 0;
+          c.v = 0;
         } else if (adv.v >= 0) {
-          v = avoider.capSpeed(scans, adv.v);
-          w = adv.w;
+          c.v = avoider.capSpeed(scans, adv.v);
+          c.w = adv.w;
         } else {
           const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-          v = corridorFree(scanPoints(scans), M_PI, hwid, s.avoid.max_range_m) > 0.5
-                  ? -s.avoid.reverse_speed
-                  : 0.0;
-          w = adv.w;
+          c.v = corridorFree(scanPoints(scans), M_PI, hwid, s.avoid.max_range_m) > 0.5
+                    ? -s.avoid.reverse_speed
+                    : 0.0;
+          c.w = adv.w;
         }
-        mode = Mode::Yield;
-        turn = turnOf(w);
+        c.turn = turnOf(c.w);
+        arb.propose(Behaviour::Yield, c);
         if (!yielding) {
           yielding = true;
           ++yields;
@@ -897,12 +899,14 @@ struct Executive::Impl {
       // is within attend_bearing_deg).
       const auto& l = tracker.route().sections[fl_k].landmarks[fl_i];
       const double b = polarFrom(pose, tracker.toOdom(l.position_m)).bearing;
-      v = 0;
-      w = std::abs(b) < 0.1 ? 0.0 : s.exec.k_heading * b;
-      mode = Mode::Look;
-      turn = turnOf(w);
+      const double w = std::abs(b) < 0.1 ? 0.0 : s.exec.k_heading * b;
+      arb.propose(Behaviour::FinalLook, {0.0, w, turnOf(w)});
     }
-    w = std::clamp(w, -s.exec.max_w, s.exec.max_w);
+    const Command& cmd = arb.winner();
+    const Mode mode = modeOf(arb.winning());
+    const servo::Turn turn = cmd.turn;
+    const double v = cmd.v;
+    const double w = std::clamp(cmd.w, -s.exec.max_w, s.exec.max_w);
     dev.base->command(v, w);
     if (obs) {
       TelemetryRow row;
