@@ -35,7 +35,7 @@ struct VariantStats {
   // every landmark fixed exactly (summary diagnostics.sketch_goal_error_m) misses it.
   int sketch_limited = 0, sketch_known = 0;
   double time_sum = 0;
-  std::vector<std::string> reasons;  // of the failed trials
+  std::vector<TrialFailure> failures;  // of the failed trials
 };
 
 // The share of `n` seeded sketches of `v` (seeds seed0, seed0 + 1, ...: the trials' sketches
@@ -233,7 +233,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
         ++st.successes;
         st.time_sum += r.time_s;
       } else {
-        st.reasons.push_back(r.reason);
+        st.failures.push_back(trialFailure(r.failure, r.reason, r.summary));
       }
     }
     const double rate = st.trials ? static_cast<double>(st.successes) / st.trials : 0.0;
@@ -258,7 +258,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
                       ? (std::to_string(static_cast<int>(std::lround(mean_t)))).c_str()
                       : "-",
                   limited.c_str(), ceil_s);
-    md << buf << summariseFailures(st.reasons) << " |\n";
+    md << buf << summariseFailures(st.failures) << " |\n";
     std::snprintf(buf, sizeof buf, "%-25s %6d  %7d  %5.0f %%  %-13s  %-14s  %s\n", v.name.c_str(),
                   st.trials, st.successes, 100 * rate,
                   std::isfinite(mean_t) ? std::to_string(mean_t).substr(0, 6).c_str() : "-",

@@ -146,7 +146,7 @@ Json cameraOnly(const ui::RunRequest& rq, const ui::RunHooks& h) {
   hw::DeviceContext ctx;
   ctx.clock = std::make_shared<hw::SteadyClock>();
   auto camera = h.wrap_camera(hw::Registry::instance().createCamera(rq.camera, ctx));
-  h.on_event({{"type", "start"}, {"t", 0.0}, {"sections", 0}, {"camera_only", true}});
+  h.on_event({0.0, nav::event::Start{0, 0.0}});  // no route: nothing but the camera
   int errors = 0;
   auto next = std::chrono::steady_clock::now();
   while (!h.stop_requested()) {

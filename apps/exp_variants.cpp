@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cctype>
 #include <cmath>
+#include <cstdio>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -306,42 +307,52 @@ void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
   std::ofstream(path) << variantSketch(v, noise, seed).dump(1) << "\n";
 }
 
-std::string summariseFailures(const std::vector<std::string>& reasons) {
+TrialFailure trialFailure(const std::string& code, const std::string& reason, const Json& summary) {
+  TrialFailure f{code, reason, ""};
+  if (code == "short_of_goal" && summary.contains("distance_to_goal_m") &&
+      summary["distance_to_goal_m"].is_number()) {
+    char b[32];
+    std::snprintf(b, sizeof b, "%.2f", summary["distance_to_goal_m"].get<double>());
+    f.detail = b;
+  } else if (code == "collision") {
+    f.detail = summary.value("collision_with", "");
+  }
+  return f;
+}
+
+std::string summariseFailures(const std::vector<TrialFailure>& failures) {
+  static const std::vector<std::pair<std::string, std::string>> kLabels = {
+      {"collision", "collision"},
+      {"short_of_goal", "stopped short of the goal [m]"},
+      {"lost", "lost (landmarks in a row not found)"},
+      {"timeout", "timeout"},
+      {"no_progress", "no progress in a section"},
+      {"safety_stop", "safety stop"},
+      {"stopped", "stopped"},
+      {"crashed", "run crashed"},
+      {"no_summary", "no summary"}};
   struct Kind {
-    std::string key;  // first clause, figures replaced by "..."
+    std::string key;  // the code, or for a trial without one its reason
     int count = 0;
-    std::vector<std::string> figures;  // per trial, when its reason had any
+    std::vector<std::string> details;
   };
   std::vector<Kind> kinds;
-  auto isDigit = [](char c) { return std::isdigit(static_cast<unsigned char>(c)) != 0; };
-  for (const auto& r : reasons) {
-    const std::string head = r.substr(0, r.find(';'));
-    std::string key, figure, figures;
-    for (size_t i = 0; i <= head.size(); ++i) {
-      const char c = i < head.size() ? head[i] : '\0';
-      if (isDigit(c) ||
-          (c == '.' && !figure.empty() && i + 1 < head.size() && isDigit(head[i + 1]))) {
-        figure += c;
-        continue;
-      }
-      if (!figure.empty()) {
-        key += "...";
-        figures += (figures.empty() ? "" : " ") + figure;
-        figure.clear();
-      }
-      if (c) key += c;
-    }
+  for (const auto& f : failures) {
+    const std::string key = f.code.empty() ? f.reason : f.code;
     auto it = std::find_if(kinds.begin(), kinds.end(), [&](const Kind& k) { return k.key == key; });
     if (it == kinds.end()) it = kinds.insert(kinds.end(), Kind{key, 0, {}});
     ++it->count;
-    if (!figures.empty()) it->figures.push_back(figures);
+    if (!f.detail.empty()) it->details.push_back(f.detail);
   }
   std::string out;
   for (const auto& k : kinds) {
-    out += (out.empty() ? "" : "; ") + std::to_string(k.count) + "x " + k.key;
-    if (k.figures.empty()) continue;
+    std::string label = k.key;
+    for (const auto& [code, words] : kLabels)
+      if (code == k.key) label = words;
+    out += (out.empty() ? "" : "; ") + std::to_string(k.count) + "x " + label;
+    if (k.details.empty()) continue;
     out += " (";
-    for (size_t i = 0; i < k.figures.size(); ++i) out += (i ? ", " : "") + k.figures[i];
+    for (size_t i = 0; i < k.details.size(); ++i) out += (i ? ", " : "") + k.details[i];
     out += ")";
   }
   return out;

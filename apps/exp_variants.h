@@ -72,10 +72,18 @@ Json variantSketch(const Variant& v, const SketchNoise& noise, int seed);
 void writeVariantSketch(const Variant& v, const SketchNoise& noise, int seed,
                         const std::string& path);
 
-/// The report's failure column: reasons counted after their first clause, with the figures in
-/// them gathered so that trials differing only by a distance count together, e.g.
-/// "2x route completed but the robot stopped ... m from the goal (0.52, 0.68)".
-std::string summariseFailures(const std::vector<std::string>& reasons);
+/// A failed trial as the report counts it.
+struct TrialFailure {
+  std::string code;    // summary.json "failure" (ScenarioResult::failure)
+  std::string reason;  // the reason text: shown for a trial without a code (an old summary)
+  std::string detail;  // per trial: short_of_goal's distance [m], collision's obstacle, or ""
+};
+/// The failure of a trial from its result: code, reason, and detail from its summary.
+TrialFailure trialFailure(const std::string& code, const std::string& reason, const Json& summary);
+
+/// The report's failure column: trials counted by failure code, in order of first appearance,
+/// with their details, e.g. "2x stopped short of the goal [m] (0.52, 0.68); 1x lost".
+std::string summariseFailures(const std::vector<TrialFailure>& failures);
 
 /// Writes the run's --config/--set settings to <out>/config.json for the child runs; returns
 /// its path, or "" when there are none.

@@ -164,52 +164,50 @@ class RunObserver final : public nav::ExecutiveObserver {
   hw::Pose2D last_truth;
   std::optional<Eigen::Vector2d> goal_odom;  // where the executive finally put the goal
 
-  std::function<void(const Json&)> on_event;  // RunOptions hooks
+  std::function<void(const nav::NavEvent&)> on_event;  // RunOptions hooks
   std::function<void(const nav::TelemetryRow&)> on_tick;
 
-  void onEvent(const nlohmann::json& e) override {
-    if (on_event) on_event(e);
-    if (e.value("type", "") == "section_done" && e.value("section", -1) == sections_ - 1 &&
-        e.contains("end_odom"))
-      goal_odom = Eigen::Vector2d(e["end_odom"][0].get<double>(), e["end_odom"][1].get<double>());
-    if (events_.is_open()) events_ << e.dump() << std::endl;  // flushed per line
+  void onEvent(const nav::NavEvent& ev) override {
+    namespace event = nav::event;
+    if (on_event) on_event(ev);
+    if (const auto* d = ev.as<event::SectionDone>(); d && d->section == sections_ - 1)
+      goal_odom = d->end_odom;
+    if (events_.is_open()) events_ << ev.toJson().dump() << std::endl;  // flushed per line
     if (!progress_) return;
-    const std::string type = e.value("type", "");
     char head[64];
-    std::snprintf(head, sizeof head, "[t=%6.1fs] ", e.value("t", 0.0));
-    std::string msg;
-    auto sec = [&](const nlohmann::json& j) {
-      return "section " + std::to_string(j.value("section", 0) + 1) + "/" +
-             std::to_string(sections_);
+    std::snprintf(head, sizeof head, "[t=%6.1fs] ", ev.t);
+    auto sec = [&](int section) {
+      return "section " + std::to_string(section + 1) + "/" + std::to_string(sections_);
     };
-    if (type == "start")
+    std::string msg;
+    if (ev.is<event::Start>()) {
       msg = "start: " + std::to_string(sections_) + " sections";
-    else if (type == "landmark_seen")
-      msg = sec(e) + ": landmark " + e.value("id", "") + " (" + e.value("class", "") + ") seen, " +
-            std::to_string(e.value("inliers", 0)) + " inliers, range " +
-            fmt(e.value("range_m", 0.0)) + " m";
-    else if (type == "landmark_passed")
-      msg = sec(e) + ": landmark " + e.value("id", "") + " passed";
-    else if (type == "landmark_missed")
-      msg = sec(e) + ": landmark " + e.value("id", "") + " not seen, continuing on odometry";
-    else if (type == "landmark_lost")
-      msg = sec(e) + ": landmark " + e.value("id", "") + " lost";
-    else if (type == "section_done")
-      msg = "section " + std::to_string(e.value("section", 0) + 1) + "/" +
-            std::to_string(sections_) + " done";
-    else if (type == "avoid_start")
-      msg = sec(e) + ": obstacle " + fmt(e.value("front_free_m", 0.0)) + " m ahead, dodging " +
-            e.value("side", "");
-    else if (type == "avoid_end")
+    } else if (const auto* e = ev.as<event::LandmarkSeen>()) {
+      msg = sec(e->section) + ": landmark " + e->id + " (" + e->class_name + ") seen, " +
+            std::to_string(e->inliers) + " inliers, range " + fmt(e->range_m) + " m";
+    } else if (const auto* e = ev.as<event::LandmarkPassed>()) {
+      msg = sec(e->section) + ": landmark " + e->id + " passed";
+    } else if (const auto* e = ev.as<event::LandmarkMissed>()) {
+      msg = sec(e->section) + ": landmark " + e->id + " not seen, continuing on odometry";
+    } else if (const auto* e = ev.as<event::LandmarkLost>()) {
+      msg = sec(e->section) + ": landmark " + e->id + " lost";
+    } else if (const auto* e = ev.as<event::SectionDone>()) {
+      msg = sec(e->section) + " done";
+    } else if (const auto* e = ev.as<event::AvoidStart>()) {
+      msg = sec(e->section) + ": obstacle " + fmt(e->front_free_m) + " m ahead, dodging " +
+            nav::toString(e->side);
+    } else if (ev.is<event::AvoidEnd>()) {
       msg = "obstacle cleared";
-    else if (type == "goal_door")
-      msg = "goal doorway found (" + fmt(e.value("width_m", 0.0)) + " m wide): the goal moved " +
-            fmt(e.value("moved_m", 0.0)) + " m to " + fmt(e.value("standoff_m", 0.0)) +
-            " m in front of it";
-    else if (type == "fault")
-      msg = "FAULT: " + e.value("reason", "");
-    else if (type == "arrived" || type == "failed")
-      msg = type + ": " + e.value("reason", "");
+    } else if (const auto* e = ev.as<event::GoalDoor>()) {
+      msg = "goal doorway found (" + fmt(e->width_m) + " m wide): the goal moved " +
+            fmt(e->moved_m) + " m to " + fmt(e->standoff_m) + " m in front of it";
+    } else if (const auto* e = ev.as<event::Fault>()) {
+      msg = "FAULT: " + e->reason;
+    } else if (const auto* e = ev.as<event::Arrived>()) {
+      msg = "arrived: " + e->reason;
+    } else if (const auto* e = ev.as<event::Failed>()) {
+      msg = "failed: " + e->reason;
+    }
     if (!msg.empty()) std::cerr << head << msg << "\n";
   }
 
@@ -228,8 +226,8 @@ class RunObserver final : public nav::ExecutiveObserver {
         row << ",,,";
       row << r.v_cmd << ',' << r.w_cmd << ',';
       if (std::isfinite(r.servo_error)) row << r.servo_error;
-      row << ',' << r.mode << ',' << r.turn << ',' << r.section << ',' << r.landmark << ','
-          << r.front_free_m << '\n';
+      row << ',' << nav::toString(r.mode) << ',' << servo::toString(r.turn) << ',' << r.section
+          << ',' << r.landmark << ',' << r.front_free_m << '\n';
       tele_ << row.str() << std::flush;
     }
     if (progress_ && r.t >= next_progress_) {
@@ -237,8 +235,8 @@ class RunObserver final : public nav::ExecutiveObserver {
       char buf[200];
       std::snprintf(buf, sizeof buf,
                     "[t=%6.1fs] section %d/%d %-6s v=%.2f m/s w=%+.2f rad/s %-8s landmark %s", r.t,
-                    r.section + 1, sections_, r.mode.c_str(), r.v_cmd, r.w_cmd, r.turn.c_str(),
-                    r.landmark.empty() ? "-" : r.landmark.c_str());
+                    r.section + 1, sections_, nav::toString(r.mode), r.v_cmd, r.w_cmd,
+                    servo::toString(r.turn), r.landmark.empty() ? "-" : r.landmark.c_str());
       std::cerr << buf << "\n";
     }
   }
@@ -360,6 +358,14 @@ Json runSettingsJson(const RunSettings& r, bool with_sim) {
   j["objectness"] = ob;
   if (with_sim) j["sim"] = paramsToJson(r.sim);
   return j;
+}
+
+std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary& es) {
+  if (success) return "";
+  if (collided) return "collision";
+  if (es.status == nav::RunStatus::Succeeded) return "short_of_goal";
+  const std::string code = nav::toString(es.failure);
+  return code.empty() ? "unknown" : code;
 }
 
 const std::vector<std::string>& driverSettingPrefixes() {
@@ -596,7 +602,9 @@ Json runNavigation(const RunOptions& o) {
                      {"match_ms", es.match_ms_mean},
                      {"full_passes", es.full_passes},
                      {"tracked_detections", es.tracked_detections}};
-  s["executive"] = {{"status", nav::toString(es.status)}, {"reason", es.reason}};
+  s["executive"] = {{"status", nav::toString(es.status)},
+                    {"failure", nav::toString(es.failure)},
+                    {"reason", es.reason}};
   // Every setting the run used, as --config takes them (the simulator's as it ran: its seed is
   // the run's --seed).
   if (simr) rs.sim = simr->params();
@@ -678,6 +686,7 @@ Json runNavigation(const RunOptions& o) {
   }
   s["success"] = success;
   s["reason"] = reason;
+  s["failure"] = failureCode(success, s.value("collided", false), es);
 
   if (!o.out_dir.empty()) {
     std::ofstream(o.out_dir + "/summary.json") << s.dump(2) << "\n";

@@ -47,7 +47,7 @@ struct RunOptions {
   // Hooks of the live run page (`sketchnav ui`); all called on the run's thread. Unset = none.
   /// Wraps the base (the page's Stop goes through the wrapper).
   std::function<std::unique_ptr<hw::Base>(std::unique_ptr<hw::Base>)> wrap_base;
-  std::function<void(const Json&)> on_event;              // every executive event
+  std::function<void(const nav::NavEvent&)> on_event;     // every executive event
   std::function<void(const nav::TelemetryRow&)> on_tick;  // every control tick
   /// Every frame perception examined, with what it found.
   std::function<void(const hw::Frame&, const nav::Observation&)> on_observation;
@@ -73,6 +73,12 @@ RunSettings runSettingsFrom(const Config& config);
 Json runSettingsJson(const RunSettings& settings, bool with_sim = true);
 /// The prefixes of device drivers' settings, applied only when a device is opened.
 const std::vector<std::string>& driverSettingPrefixes();
+
+/// summary.json's "failure", the code beside its "reason": "" when the run succeeded,
+/// "collision", "short_of_goal" (the executive arrived, ground truth puts the robot outside the
+/// goal region), else the executive's nav::FailureCode ("lost", "timeout", "no_progress",
+/// "safety_stop", "stopped").
+std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary& es);
 
 /// Runs one navigation. Returns the summary object (what summary.json holds). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.

@@ -125,18 +125,21 @@ ScenarioResult readRunFolder(const std::string& dir) {
   std::ifstream sj(dir + "/summary.json");
   if (!sj) {
     r.reason = "no summary: " + lastLine(dir + "/run.log");
+    r.failure = "no_summary";
     return r;
   }
   try {
     r.summary = Json::parse(sj);
   } catch (const std::exception& e) {
     r.reason = std::string("unreadable summary.json: ") + e.what();
+    r.failure = "no_summary";
     return r;
   }
   const Json& s = r.summary;
   r.ran = true;
   r.success = s.value("success", false);
   r.reason = s.value("reason", "");
+  r.failure = s.value("failure", "");
   r.time_s = jnum(s, "time_s");
   r.path_m = jnum(s, "path_length_m");
   r.min_clearance_m = jnum(s, "min_clearance_m", NAN);
@@ -189,10 +192,13 @@ std::vector<ScenarioResult> runScenarios(const std::vector<ScenarioSpec>& specs,
       const auto t0 = std::chrono::steady_clock::now();
       const int rc = spawnRun(s, exe);
       results[i] = readRunFolder(s.out_dir);
-      if (rc < 0)
+      if (rc < 0) {
         results[i].reason = "could not start " + exe;
-      else if (!results[i].ran && rc >= 128)
+        results[i].failure = "crashed";
+      } else if (!results[i].ran && rc >= 128) {
         results[i].reason = "run crashed (status " + std::to_string(rc) + ")";
+        results[i].failure = "crashed";
+      }
       const double wall =
           std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
       if (progress) {

@@ -30,6 +30,9 @@ struct ScenarioResult {
   bool ran = false;      // the child produced a summary (false: it crashed / bad input)
   bool success = false;  // reached the goal without collision (simulator ground truth)
   std::string reason;
+  // summary.json's "failure" code (run_harness.h failureCode): "" on success; "no_summary" or
+  // "crashed" when the child wrote no readable summary; "" from a summary older than the code.
+  std::string failure;
   double time_s = 0;                                 // simulated time to the end of the run
   double path_m = 0;                                 // true distance travelled
   double deviation_mean_m = 0, deviation_max_m = 0;  // from the sketched path

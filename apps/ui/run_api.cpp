@@ -134,6 +134,7 @@ struct RunController::Live {
   // executive
   bool has_tick = false;
   nav::TelemetryRow tick;
+  std::string end_mode;  // set when the run has ended: its status, shown as the mode
   int sections = 0;
   double route_length_m = 0;
   std::deque<Json> events;
@@ -170,6 +171,7 @@ struct RunController::Live {
     stop_requested = false;
     has_tick = false;
     tick = {};
+    end_mode.clear();
     sections = 0;
     route_length_m = 0;
     events.clear();
@@ -395,23 +397,34 @@ bool RunController::stop() {
 void RunController::runThread(RunRequest request) {
   auto live = live_;
   RunHooks h;
-  h.on_event = [live](const Json& e) {
+  h.on_event = [live](const nav::NavEvent& e) {
+    namespace event = nav::event;
     std::lock_guard<std::mutex> l(live->m);
-    live->events.push_back(e);
+    live->events.push_back(e.toJson());
     while (live->events.size() > 40) live->events.pop_front();
-    const std::string type = e.value("type", "");
-    if (type == "start") {
-      live->sections = e.value("sections", 0);
-      live->route_length_m = e.value("route_length_m", 0.0);
+    if (const auto* s = e.as<event::Start>()) {
+      live->sections = s->sections;
+      live->route_length_m = s->route_length_m;
       if (live->status == "starting") live->status = "running";
     }
-    if (e.contains("id") && e["id"].is_string() && type.rfind("landmark_", 0) == 0) {
-      Json& lm = live->landmarks[e["id"].get<std::string>()];
-      lm["id"] = e["id"];
-      if (e.contains("class")) lm["class"] = e["class"];
-      if (e.contains("section")) lm["section"] = e["section"];
-      lm["state"] = type.substr(9);  // seen passed missed lost
-      if (e.contains("inliers")) lm["inliers"] = e["inliers"];
+    // The landmark table: its state is the last landmark event's (seen passed missed lost).
+    auto landmark = [&](const std::string& id, const char* state, int section) -> Json& {
+      Json& lm = live->landmarks[id];
+      lm["id"] = id;
+      lm["section"] = section;
+      lm["state"] = state;
+      return lm;
+    };
+    if (const auto* x = e.as<event::LandmarkSeen>()) {
+      Json& lm = landmark(x->id, "seen", x->section);
+      lm["class"] = x->class_name;
+      lm["inliers"] = x->inliers;
+    } else if (const auto* x = e.as<event::LandmarkPassed>()) {
+      landmark(x->id, "passed", x->section)["class"] = x->class_name;
+    } else if (const auto* x = e.as<event::LandmarkMissed>()) {
+      landmark(x->id, "missed", x->section)["class"] = x->class_name;
+    } else if (const auto* x = e.as<event::LandmarkLost>()) {
+      landmark(x->id, "lost", x->section);
     }
   };
   h.on_tick = [live](const nav::TelemetryRow& r) {
@@ -466,8 +479,7 @@ void RunController::runThread(RunRequest request) {
   live->base_open = false;
   // The executive's last tick was before it stopped the base: show the robot at rest.
   live->tick.v_cmd = live->tick.w_cmd = 0;
-  live->tick.mode = status;
-  live->tick.turn = "";
+  live->end_mode = status;
 }
 
 Json RunController::state() const {
@@ -484,8 +496,9 @@ Json RunController::state() const {
     const auto& r = L.tick;
     s["t"] = r.t;
     s["section"] = std::min(r.section + 1, std::max(L.sections, 1));  // 1-based k of n
-    s["mode"] = r.mode;
-    s["turn"] = r.turn;
+    // Once the run is over the page shows how it ended instead of the last tick's mode.
+    s["mode"] = L.end_mode.empty() ? std::string(nav::toString(r.mode)) : L.end_mode;
+    s["turn"] = L.end_mode.empty() ? std::string(servo::toString(r.turn)) : std::string();
     s["v"] = r.v_cmd;
     s["w"] = r.w_cmd;
     s["servo_error"] = std::isfinite(r.servo_error) ? Json(r.servo_error) : Json(nullptr);

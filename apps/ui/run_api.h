@@ -61,7 +61,7 @@ struct RunRequest {
 /// How a runner reports to the page. All are set by RunController and called on the run's
 /// thread.
 struct RunHooks {
-  std::function<void(const Json&)> on_event;              // executive events
+  std::function<void(const nav::NavEvent&)> on_event;     // executive events
   std::function<void(const nav::TelemetryRow&)> on_tick;  // every control tick
   std::function<void(const hw::Frame&, const nav::Observation&)> on_observation;
   std::function<std::unique_ptr<hw::Camera>(std::unique_ptr<hw::Camera>)> wrap_camera;
@@ -104,8 +104,11 @@ class RunController {
 
   /// Starts a run on the background thread. InputError when one is already going.
   void start(const RunRequest& request);
-  /// Stops the base at once (real robot: from this thread; simulator: at its next command),
-  /// then the run ends with "stopped by user". Returns false when no run was going.
+  /// Stops the base at once (real robot: hw::Base::stop() on the calling thread, the HTTP
+  /// server's, serialised with the run thread's calls by StoppableBase's mutex; simulator: at
+  /// its next command, on the run thread), then the run ends with "stopped by user" (the
+  /// executive polls RunHooks::stop_requested between ticks; it is never called from this
+  /// thread). Returns false when no run was going. Thread-safe.
   bool stop();
   /// Waits for the run thread to finish (tests, shutdown).
   void join();

@@ -83,7 +83,7 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
     h.on_map({{"frame", "odometry"}, {"sketch_path", {{0, 0}, {3, 0}, {3, 2}}}});
     auto camera = h.wrap_camera(std::make_unique<FakeCamera>());
     auto base = h.wrap_base(std::make_unique<FakeBase>(log));
-    h.on_event({{"type", "start"}, {"t", 0.0}, {"sections", 3}, {"route_length_m", 5.0}});
+    h.on_event({0.0, nav::event::Start{3, 5.0}});
     std::string reason = "arrived";
     bool success = true;
     for (int i = 0; i < max_ticks; ++i) {
@@ -91,7 +91,7 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
         base->stop();
         reason = "stopped by user";
         success = false;
-        h.on_event({{"type", "failed"}, {"t", i * 0.05}, {"reason", reason}});
+        h.on_event({i * 0.05, nav::event::Failed{nav::FailureCode::Stopped, reason}});
         break;
       }
       hw::Frame f;
@@ -112,8 +112,8 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
       r.odom.x = i * 0.015;
       r.v_cmd = 0.3;
       r.w_cmd = 0.1;
-      r.mode = "follow";
-      r.turn = "Straight";
+      r.mode = nav::Mode::Follow;
+      r.turn = servo::Turn::Straight;
       r.section = std::min(2, i / 20);
       h.on_tick(r);
       std::this_thread::sleep_for(std::chrono::milliseconds(10));

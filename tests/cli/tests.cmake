@@ -41,8 +41,14 @@ add_test(NAME cli_settings_strict
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings.cmake)
 set_tests_properties(cli_settings_strict PROPERTIES TIMEOUT 300)
+# Two simulated runs with one seed write identical telemetry.csv and events.jsonl.
+add_test(NAME cli_run_deterministic
+  COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DSRC=${PROJECT_SOURCE_DIR}
+          -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-run-deterministic
+          -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/determinism.cmake)
+set_tests_properties(cli_run_deterministic PROPERTIES TIMEOUT 300)
 # A short simulated run repeated from its summary's settings as --config: same settings,
-# same outcome.
+# same outcome, same telemetry.
 add_test(NAME cli_settings_roundtrip
   COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-settings-roundtrip
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/settings_roundtrip.cmake)

@@ -172,18 +172,28 @@ TEST(Plot, ConfusionMatrixShadesByRowShareAndOutlinesTheRightAnswers) {
 }  // namespace
 }  // namespace sketchnav::app
 
-TEST(ExperimentsReport, FailuresCountTogetherWhenOnlyTheirFiguresDiffer) {
-  const std::vector<std::string> reasons = {
-      "route completed but the robot stopped 0.61 m from the goal",
-      "collision with pedestrian left; safety stop: base link lost",
-      "route completed but the robot stopped 0.82 m from the goal",
-      "collision with pedestrian left; safety stop: base link lost",
-      "route completed but the robot stopped 0.6 m from the goal"};
-  EXPECT_EQ(sketchnav::app::summariseFailures(reasons),
-            "3x route completed but the robot stopped ... m from the goal (0.61, 0.82, 0.6); "
-            "2x collision with pedestrian left");
-  // Five long reasons are not cut (the report's row once was, at 300 characters).
-  std::vector<std::string> many(5, std::string(120, 'x'));
+TEST(ExperimentsReport, FailuresCountByCodeWithTheirDetails) {
+  using sketchnav::app::TrialFailure;
+  using sketchnav::app::trialFailure;
+  const sketchnav::Json short1 = {{"distance_to_goal_m", 0.613}};
+  const sketchnav::Json short2 = {{"distance_to_goal_m", 0.82}};
+  const sketchnav::Json hit = {{"collision_with", "pedestrian left"}};
+  const std::vector<TrialFailure> failures = {
+      trialFailure("short_of_goal", "route completed but the robot stopped 0.61 m from the goal",
+                   short1),
+      trialFailure("collision", "collision with pedestrian left; safety stop: base link lost", hit),
+      trialFailure("short_of_goal", "route completed but the robot stopped 0.82 m from the goal",
+                   short2),
+      // The reason's words do not decide the group: the code does.
+      trialFailure("lost", "lost: 3 landmarks in a row not found (L2, L3, L4)", {}),
+      trialFailure("lost", "something else entirely", {}),
+      // A summary older than the code is counted by its reason.
+      trialFailure("", "an old reason 1.5 m", {})};
+  EXPECT_EQ(sketchnav::app::summariseFailures(failures),
+            "2x stopped short of the goal [m] (0.61, 0.82); 1x collision (pedestrian left); "
+            "2x lost (landmarks in a row not found); 1x an old reason 1.5 m");
+  // Long reasons are not cut (the report's row once was, at 300 characters).
+  std::vector<TrialFailure> many(5, TrialFailure{"", std::string(120, 'x'), ""});
   EXPECT_EQ(sketchnav::app::summariseFailures(many), "5x " + std::string(120, 'x'));
   EXPECT_EQ(sketchnav::app::summariseFailures({}), "");
 }

@@ -48,7 +48,9 @@ struct DaniLinkStatus {
   std::string last_error;
 };
 
-/// The shared link (one per dani:// authority). Thread-safe.
+/// The shared link (one per dani:// authority). Thread-safe: every call takes one internal
+/// mutex shared with the receive thread, so command(), stop() and odometry() may come from
+/// any thread, concurrently (DaniBase and DaniSonar forward to it).
 class DaniLink {
  public:
   /// `secret` empty: CRC-32 datagrams; else HMAC-SHA256 (must match the base's).

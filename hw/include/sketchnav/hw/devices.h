@@ -2,6 +2,17 @@
 // The three device interfaces. Small on purpose: each real device (GigE camera, DaNI base,
 // laser) and its simulated twin implement exactly these, nothing more. Devices are not
 // copyable; their lifetime is the unique_ptr the registry returns.
+//
+// Threads. A device is not required to be safe for concurrent calls: its user makes one call
+// at a time. Those calls may come from different threads in turn, so an implementation must
+// not depend on which thread calls it (no thread-local state, no handle bound to the thread
+// that opened it) and must synchronise with any thread of its own (a receive or polling loop).
+// Where this matters: the run page's Stop (`sketchnav ui`, StoppableBase in
+// apps/ui/run_api.cpp) calls Base::stop() of a real robot's base on the HTTP server's thread
+// while the run's thread is driving; StoppableBase serialises it with the run thread's
+// command(), odometry(), ok() and stats() under one mutex. (On the simulator it only flags
+// the stop, and the run thread's next command() becomes stop().) Implementations that are
+// safe for concurrent calls say so: DaniLink/DaniBase, GatedBase, sim::Simulator's devices.
 #include <string>
 
 #include "sketchnav/hw/types.h"
@@ -40,7 +51,8 @@ class Base {
   /// Velocity command: v forward [m/s], w yaw rate [rad/s] CCW positive. The base applies its
   /// own limits; a base with a watchdog stops when commands stop arriving.
   virtual void command(double v, double w) = 0;
-  /// Stop now. Must not throw (it is what every fault path calls).
+  /// Stop now. Must not throw (it is what every fault path calls). May be called on another
+  /// thread than the previous command() (see "Threads" above: the run page's Stop).
   virtual void stop() noexcept = 0;
   /// Latest odometry; false when none is available (link down, not started).
   virtual bool odometry(Odometry& out) = 0;

@@ -20,6 +20,7 @@
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/avoidance.h"
 #include "sketchnav/nav/doorway.h"
+#include "sketchnav/nav/events.h"
 #include "sketchnav/nav/landmark_stage.h"
 #include "sketchnav/nav/laser_odometry.h"
 #include "sketchnav/nav/local_planner.h"
@@ -206,22 +207,36 @@ NavSettings navSettingsFrom(const Config& config);
 
 /// One control tick, for telemetry.csv.
 struct TelemetryRow {
-  double t = 0;
+  double t = 0;  // [s] since start()
   hw::Pose2D odom;
-  double v_cmd = 0, w_cmd = 0;
-  double servo_error = 0;  // x_t - x_d when servoing, NaN otherwise
-  std::string mode;  // follow | look | servo | dock | recover | avoid | detour | stopped | done |
-                     // failed
-  std::string turn;  // Left | Straight | Right
+  double v_cmd = 0, w_cmd = 0;  // [m/s], [rad/s] as commanded to the base
+  double servo_error = 0;       // x_t - x_d when servoing, NaN otherwise
+  Mode mode = Mode::Follow;     // what drove this tick: follow | look | servo | dock | recover |
+                                // avoid | detour | yield (toString(Mode))
+  // The turn: servoing, the turn law's; following, looking ahead or docking, the side of the
+  // bearing steered to; recovering, avoiding, detouring, yielding or looking on the spot, the
+  // sign of the yaw rate (|x| < 0.05 is Straight).
+  servo::Turn turn = servo::Turn::Straight;
   int section = 0;
   std::string landmark;     // id of the attended landmark ("" when none)
-  double front_free_m = 0;  // free corridor ahead
+  double front_free_m = 0;  // [m] free corridor ahead (0 when the avoider did not run)
 };
 
+/// Receives what the executive reports. Contract of both calls:
+/// - They are made synchronously, on the thread that calls Executive::start(), step() or
+///   run() (the executive has no threads of its own), inside that call: a slow observer slows
+///   the control loop.
+/// - The argument is valid only during the call (copy what is kept).
+/// - An observer must not call back into the Executive that calls it.
+/// - An exception thrown from a call made inside step() ends the run like any fault in the
+///   tick: the base is stopped and the run is Failed (FailureCode::SafetyStop); one thrown from
+///   start()'s Start event propagates out of start().
+/// Events come in time order: Start first (from start()), then whatever the ticks report;
+/// Arrived or Failed once, when the run ends (Failed may follow a Fault).
 class ExecutiveObserver {
  public:
   virtual ~ExecutiveObserver() = default;
-  virtual void onEvent(const nlohmann::json& event) {}
+  virtual void onEvent(const NavEvent& event) {}
   virtual void onTick(const TelemetryRow& row) {}
 };
 
@@ -237,9 +252,10 @@ struct LandmarkReport {
 
 struct ExecutiveSummary {
   RunStatus status = RunStatus::Idle;
-  std::string reason;
-  double time_s = 0;       // [s] on the run's clock
-  double odom_path_m = 0;  // distance travelled by odometry
+  FailureCode failure = FailureCode::None;  // why it failed (None unless status is Failed)
+  std::string reason;                       // the verdict in words (with figures), beside it
+  double time_s = 0;                        // [s] on the run's clock
+  double odom_path_m = 0;                   // distance travelled by odometry
   int sections_done = 0, sections = 0;
   std::vector<LandmarkReport> landmarks;
   int frames = 0;            // camera frames grabbed
@@ -263,6 +279,11 @@ struct Devices {
   hw::Clock* clock = nullptr;
 };
 
+/// Not thread-safe: start(), step(), stop(), run() and summary() from one thread (the one that
+/// drives it, which is also the one the observer and the devices are called on). To stop a run
+/// from another thread, set a flag that the driving thread polls between step()s and calls
+/// stop() on (RunOptions::stop_requested), and stop the base itself through a wrapper that
+/// serialises with the driving thread (the run page's StoppableBase, hw/devices.h "Threads").
 class Executive {
  public:
   /// Configure. Throws InputError for invalid settings or an empty route.
@@ -276,7 +297,8 @@ class Executive {
   /// One control tick at the clock's current time. Never throws: any exception stops the
   /// base and fails the run.
   void step();
-  /// Stops the base (idempotent). A run stopped while Running is Failed with `reason`.
+  /// Stops the base (idempotent). A run stopped while Running is Failed with `reason`
+  /// (FailureCode::Stopped).
   void stop(const std::string& reason = "stopped");
   bool done() const;
   /// start(); loop { clock->sleepUntil(next tick); step(); } until done(); returns summary().
