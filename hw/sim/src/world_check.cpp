@@ -6,6 +6,7 @@
 #include <cstdio>
 #include <map>
 #include <optional>
+#include <queue>
 
 #include "geometry.h"
 
@@ -257,6 +258,70 @@ std::vector<WorldIssue> checkStartHeading(const World& w, const RoutePlacement& 
                 delta > 0 ? "counter-clockwise" : "clockwise", used, used == 1 ? "" : "s");
   if (deg > p.heading_error_deg) return {error("start.yaw_deg", b)};
   return {warning("start.yaw_deg", b)};
+}
+
+double freePathLength(const World& w, double margin_m, double res) {
+  if (w.floor.size() < 3 || !(res > 0)) return -1;
+  double x0 = geom::kInf, y0 = geom::kInf, x1 = -geom::kInf, y1 = -geom::kInf;
+  for (const auto& q : w.floor) {
+    x0 = std::min(x0, q.x()), y0 = std::min(y0, q.y());
+    x1 = std::max(x1, q.x()), y1 = std::max(y1, q.y());
+  }
+  const int nx = static_cast<int>(std::ceil((x1 - x0) / res)),
+            ny = static_cast<int>(std::ceil((y1 - y0) / res));
+  if (nx <= 0 || ny <= 0 || static_cast<double>(nx) * ny > 2e7) return -1;
+  const geom::Solids solids = geom::buildSolids(w);
+  const double need = w.robot.radius + margin_m;
+  auto centre = [&](int i, int j) { return Vec2(x0 + (i + 0.5) * res, y0 + (j + 0.5) * res); };
+  std::vector<char> free(static_cast<size_t>(nx) * ny, 0);
+  for (int j = 0; j < ny; ++j)
+    for (int i = 0; i < nx; ++i) {
+      const Vec2 c = centre(i, j);
+      if (!geom::pointInPolygon(c, w.floor)) continue;
+      bool ok = true;
+      for (const auto& p : solids.polys)
+        if (geom::signedDistance(c, p) < need) {
+          ok = false;
+          break;
+        }
+      for (size_t k = 0; ok && k < solids.circles.size(); ++k)
+        ok = (c - solids.circles[k].c).norm() - solids.circles[k].r >= need;
+      free[static_cast<size_t>(j) * nx + i] = ok;
+    }
+  auto cellOf = [&](const Vec2& p) {
+    const int i = std::clamp(static_cast<int>((p.x() - x0) / res), 0, nx - 1);
+    const int j = std::clamp(static_cast<int>((p.y() - y0) / res), 0, ny - 1);
+    return j * nx + i;
+  };
+  const int s = cellOf({w.start.x, w.start.y});
+  free[s] = 1;  // the start itself was checked at load with the bare radius
+  // Dijkstra over the grid (steps of res and res * sqrt 2).
+  std::vector<double> dist(free.size(), geom::kInf);
+  using Item = std::pair<double, int>;
+  std::priority_queue<Item, std::vector<Item>, std::greater<Item>> queue;
+  dist[s] = 0;
+  queue.push({0.0, s});
+  while (!queue.empty()) {
+    const auto [d, c] = queue.top();
+    queue.pop();
+    if (d > dist[c]) continue;
+    const int ci = c % nx, cj = c / nx;
+    if ((centre(ci, cj) - w.goal.centre).norm() <= w.goal.radius) return d;
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const int i = ci + di, j = cj + dj;
+        if ((!di && !dj) || i < 0 || j < 0 || i >= nx || j >= ny) continue;
+        const int n = j * nx + i;
+        // No corner cutting: a diagonal step needs both side cells free.
+        if (!free[n] || (di && dj && (!free[cj * nx + i] || !free[j * nx + ci]))) continue;
+        const double nd = d + res * ((di && dj) ? M_SQRT2 : 1.0);
+        if (nd < dist[n]) {
+          dist[n] = nd;
+          queue.push({nd, n});
+        }
+      }
+  }
+  return -1;
 }
 
 }  // namespace sketchnav::sim

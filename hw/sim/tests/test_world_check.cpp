@@ -206,3 +206,23 @@ TEST(WorldCheck, ShippedWorldsHaveNoErrors) {
     EXPECT_EQ(count(sim::checkWorldGeometry(w), true), 0) << name;
   }
 }
+
+TEST(WorldCheck, FreePathFoundAroundFurnitureAndNotThroughAWall) {
+  Json j = roomJson();
+  const double open = sim::freePathLength(load(j));
+  EXPECT_GT(open, 3.3);  // start (1, 2) to the goal circle around (5, 2), radius 0.5: 3.5 m
+  EXPECT_LT(open, 3.7);
+  // A partition across the room with a 0.8 m gap near the north wall: the way goes round.
+  Json g = roomJson();
+  g["walls"].push_back({{"name", "partition"}, {"from", {3, 0}}, {"to", {3, 3.2}}});
+  const double around = sim::freePathLength(load(g));
+  EXPECT_GT(around, 4.2);  // via the gap at (3, 3.6): about 4.4 m
+  // Closed completely: none.
+  Json c = roomJson();
+  c["walls"].push_back({{"name", "partition"}, {"from", {3, 0}}, {"to", {3, 4}}});
+  EXPECT_LT(sim::freePathLength(load(c)), 0);
+  // A gap narrower than the robot (0.3 m < 2 x 0.25 m) is no way either.
+  Json n = roomJson();
+  n["walls"].push_back({{"name", "partition"}, {"from", {3, 0}}, {"to", {3, 3.7}}});
+  EXPECT_LT(sim::freePathLength(load(n)), 0);
+}

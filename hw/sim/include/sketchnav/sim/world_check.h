@@ -70,4 +70,10 @@ std::vector<WorldIssue> checkStartHeading(const World& w, const RoutePlacement& 
                                           const WorldCheckParams& p = {},
                                           double* out_disagreement_rad = nullptr);
 
+/// A free path for the robot's disc from the start to the goal region, ignoring pedestrians:
+/// a shortest-path search (Dijkstra) over a `resolution_m` grid of the floor whose cells keep the
+/// robot's radius + `margin_m` from every wall, closed door and obstacle (8-connected). Returns the
+/// path length [m] (over grid steps), or a negative number when there is none.
+double freePathLength(const World& w, double margin_m = 0.05, double resolution_m = 0.1);
+
 }  // namespace sketchnav::sim
