@@ -3,7 +3,7 @@
 set(SN $<TARGET_FILE:sketchnav>)
 set(EXP_DIR ${CMAKE_CURRENT_SOURCE_DIR}/experiments)
 set(EXP_WORK ${CMAKE_CURRENT_BINARY_DIR}/experiments-work)
-foreach(t replay_rendered tune_reproducible short_run bad_input)
+foreach(t replay_rendered tune_reproducible short_run bad_input scenarios_slice)
   add_test(NAME experiments_${t}
     COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${EXP_WORK}/${t} -DSHARE=${PROJECT_SOURCE_DIR}/share
             -P ${EXP_DIR}/${t}.cmake)
