@@ -75,6 +75,20 @@ Telemetry readTelemetry(const std::string& dir, const sim::World& w) {
   return t;
 }
 
+// How often each executive event happened in a run (events.jsonl): which behaviours a run
+// leaned on, the input for a failure's "why".
+Json eventCounts(const std::string& dir) {
+  std::map<std::string, int> n;
+  std::ifstream in(dir + "/events.jsonl");
+  for (std::string line; std::getline(in, line);) {
+    try {
+      ++n[Json::parse(line).value("type", "?")];
+    } catch (const std::exception&) {
+    }
+  }
+  return n;
+}
+
 Json numOrNull(double x) {
   return std::isfinite(x) ? Json(x) : Json(nullptr);
 }
@@ -277,6 +291,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
     r["clearance_people_m"] = numOrNull(t.people_m);
     r["clearance_obstacles_m"] = numOrNull(t.obstacles_m);
     r["mode_share"] = t.mode_share;
+    r["events"] = eventCounts(dir);
     const Json diag = sm.value("diagnostics", Json::object());
     r["sketch_goal_error_m"] = diag.contains("sketch_goal_error_m")
                                    ? diag["sketch_goal_error_m"]
@@ -313,8 +328,9 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   for (const auto& k : sketchErrorKinds())
     if (by_kind.count(k)) md << by_kind[k].row("with " + k) << "\n";
   if (by_kind.count("(none)")) md << by_kind["(none)"].row("no drawing error") << "\n";
-  md << "\n| scenario | success | reason | goal error [m] | sketch goal error [m] | errors |\n"
-        "|---|---|---|---:|---:|---|\n";
+  md << "\n| scenario | success | reason | goal error [m] | sketch goal error [m] | odometry "
+        "error [m] | landmarks seen | ticks avoiding | errors |\n"
+        "|---|---|---|---:|---:|---:|---:|---:|---|\n";
   for (const auto& r : rows) {
     std::string kinds;
     for (const auto& k : r["errors"]) kinds += (kinds.empty() ? "" : ", ") + k.get<std::string>();
@@ -324,8 +340,14 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (r["sketch_goal_error_m"].is_number())
       std::snprintf(c, sizeof c, "%.2f", r["sketch_goal_error_m"].get<double>());
     md << "| " << r["name"].get<std::string>() << " | " << (r["success"].get<bool>() ? "yes" : "no")
-       << " | " << r["reason"].get<std::string>() << " | " << b << " | " << c << " | " << kinds
-       << " |\n";
+       << " | " << r["reason"].get<std::string>() << " | " << b << " | " << c << " | ";
+    if (r["odometry_error_m"].is_number())
+      md << std::round(r["odometry_error_m"].get<double>() * 100) / 100;
+    else
+      md << "-";
+    const double avoid = r["mode_share"].value("avoid", 0.0) + r["mode_share"].value("detour", 0.0);
+    md << " | " << r["landmarks_recognised"].get<size_t>() << "/" << r["landmarks"].get<size_t>()
+       << " | " << std::lround(100 * avoid) << " % | " << kinds << " |\n";
   }
   std::ofstream(out + "/benchmark.md") << md.str();
   if (g.json)

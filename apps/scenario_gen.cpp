@@ -856,7 +856,8 @@ Drawn drawSketch(const World& W, const std::vector<Poster>& remembered, const st
                  W.L.discFree(m + t * (b - m), 0.3, 0.0, false);
       if (!inside) continue;
       out.errors.push_back(
-          {"corner_wrong_side", {{"corner", i}, {"moved_m", round2((m - R[i]).norm())}}});
+          {"corner_wrong_side",
+           {{"corner", i}, {"moved_m", round2((m - R[i]).norm())}, {"drawn_at", j2(m)}}});
       R[i] = m;
       break;
     }
@@ -951,6 +952,24 @@ Drawn drawSketch(const World& W, const std::vector<Poster>& remembered, const st
                 {"path", path},
                 {"start", {std::round(start_px.x() * 10) / 10, std::round(start_px.y() * 10) / 10}},
                 {"goal", {std::round(goal_px.x() * 10) / 10, std::round(goal_px.y() * 10) / 10}}};
+  return out;
+}
+
+// The checks' warnings: the world's geometry and the start heading against the sketch.
+std::vector<std::string> scenarioWarnings(const GeneratedScenario& g) {
+  std::vector<std::string> out;
+  try {
+    const sim::World w = sim::worldFromJson(g.world, g.name, resourceDir());
+    for (const auto& i : sim::checkWorldGeometry(w)) out.push_back(i.text(g.name));
+    const auto route = mapsketch::toRoute(mapsketch::sketchFromJson(g.sketch, g.name));
+    sim::RoutePlacement placed{route.start_m, route.start_heading_rad, {}};
+    for (const auto& sec : route.sections)
+      for (const auto& lm : sec.landmarks) placed.landmarks.push_back({lm.id, lm.position_m});
+    for (const auto& i : sim::checkStartHeading(w, placed, g.name + ".sketch.json"))
+      out.push_back(i.text(g.name));
+  } catch (const InputError& e) {
+    out.push_back(e.what());
+  }
   return out;
 }
 
@@ -1054,7 +1073,17 @@ std::optional<GeneratedScenario> attempt(const std::string& family, std::uint64_
   g.world = worldJson(W, g.name, family, start_yaw, rng);
   Drawn dr = drawSketch(W, remembered, g.name, rng, B, kinds);
   g.sketch = dr.sketch;
-  for (auto& e : dr.errors) g.errors.push_back(e);
+  for (auto& e : dr.errors) {
+    // The first corner drawn round the other way: the person puts the robot down facing the
+    // way they drew (the start heading error, if any, on top).
+    if (e.kind == "corner_wrong_side" && e.params["corner"] == 1) {
+      const V2 m(e.params["drawn_at"][0].get<double>(), e.params["drawn_at"][1].get<double>());
+      const V2 d = m - W.L.route[0];
+      const double yaw = std::atan2(d.y(), d.x()) + (start_yaw - std::atan2(d0.y(), d0.x()));
+      g.world["start"]["yaw_deg"] = round2(yaw / kDeg);
+    }
+    g.errors.push_back(e);
+  }
   // Report order.
   std::stable_sort(g.errors.begin(), g.errors.end(), [](const auto& a, const auto& b) {
     return std::find(kKinds.begin(), kKinds.end(), a.kind) <
@@ -1073,11 +1102,12 @@ std::optional<GeneratedScenario> attempt(const std::string& family, std::uint64_
       std::fprintf(stderr, "%s attempt %d: %s\n", g.name.c_str(), att, problems.front().c_str());
     return std::nullopt;
   }
-  try {
-    for (const auto& i :
-         sim::checkWorldGeometry(sim::worldFromJson(g.world, g.name, resourceDir())))
-      g.warnings.push_back(i.text(g.name));
-  } catch (const InputError&) {
+  // No warnings either: a generated world is meant to be clean (a free-standing board or
+  // overlapping furniture would be the generator's slip, not a test of the robot).
+  g.warnings = scenarioWarnings(g);
+  if (!g.warnings.empty()) {
+    if (std::getenv("SKETCHNAV_SCENARIO_DEBUG"))
+      std::fprintf(stderr, "%s attempt %d: %s\n", g.name.c_str(), att, g.warnings.front().c_str());
     return std::nullopt;
   }
   return g;

@@ -128,8 +128,14 @@ TEST(ScenarioGenerator, SketchErrorsAreWithinTheirBounds) {
           missing.insert(p["id"].get<std::string>());
         }
       }
-      // Measured: the start heading against the route's first leg.
-      const Eigen::Vector2d d0 = s.route[1] - s.route[0];
+      // Measured: the start heading against the route's first leg (as drawn, when its first
+      // corner was drawn round the other way: the person faces the robot along their stroke).
+      Eigen::Vector2d first_corner = s.route[1];
+      for (const auto& e : s.errors)
+        if (e.kind == "corner_wrong_side" && e.params["corner"] == 1)
+          first_corner = {e.params["drawn_at"][0].get<double>(),
+                          e.params["drawn_at"][1].get<double>()};
+      const Eigen::Vector2d d0 = first_corner - s.route[0];
       const double first = std::atan2(d0.y(), d0.x());
       const double err = std::remainder(w.start.theta - first, 2 * M_PI) * 180 / M_PI;
       EXPECT_LE(std::abs(err), s.hasError("start_heading") ? B.heading_deg + 0.01 : 0.01) << s.name;
