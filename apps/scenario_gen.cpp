@@ -436,6 +436,17 @@ struct Box {
   }
 };
 
+// The box as the world file will hold it (centimetres, hundredths of a degree): a photo on
+// its face is placed from these numbers, so rounding cannot bury it in the box.
+void quantise(Box& b) {
+  b.c = V2(round2(b.c.x()), round2(b.c.y()));
+  b.sx = round2(b.sx);
+  b.sy = round2(b.sy);
+  b.r = round2(b.r);
+  b.yaw = round2(b.yaw / kDeg) * kDeg;
+  b.height = round2(b.height);
+}
+
 struct Poster {
   std::string id, cls;
   V2 pos;
@@ -528,9 +539,10 @@ std::optional<Poster> placeLandmark(World& W, Rng& rng, double s, bool open_room
       b.sy = rng.uniform(0.8, 1.4);
       b.yaw = face_yaw;
       b.height = rng.uniform(1.0, 1.6);
+      quantise(b);
       if (!fits(W, b, 1.0)) continue;
-      ps.yaw = face_yaw;
-      ps.pos = b.c + (b.sx / 2) * V2(std::cos(face_yaw), std::sin(face_yaw));
+      ps.yaw = b.yaw;
+      ps.pos = b.c + (b.sx / 2 + 0.001) * V2(std::cos(b.yaw), std::sin(b.yaw));
       ps.elevation = round2(std::min(b.height - ps.h / 2 - 0.05, rng.uniform(0.6, 1.2)));
       if (ps.elevation - ps.h / 2 < 0.05) continue;
       ps.on = "furniture face";
@@ -541,7 +553,7 @@ std::optional<Poster> placeLandmark(World& W, Rng& rng, double s, bool open_room
     if (!wall) continue;
     const double dist = (*wall - p).dot(side);
     const V2 n_in = -side;
-    if (kind <= 1 || kind == 0) {
+    if (kind <= 1) {
       if (kind == 0) {
         if (dist < 0.8 || !wallContinues(W.L, p, side, dist, ps.w / 2 + 0.1)) continue;
         ps.pos = *wall + n_in * (0.5 * kWallT);
@@ -559,6 +571,7 @@ std::optional<Poster> placeLandmark(World& W, Rng& rng, double s, bool open_room
       const bool top = rng.chance(0.4);
       Box b = againstWall((top ? "low cabinet " : "cabinet ") + std::to_string(n), *wall, n_in,
                           width, depth, top ? rng.uniform(0.7, 1.0) : rng.uniform(1.2, 1.9));
+      quantise(b);
       if (!fits(W, b, 0.7)) continue;
       ps.yaw = std::atan2(n_in.y(), n_in.x());
       if (top) {
@@ -566,12 +579,11 @@ std::optional<Poster> placeLandmark(World& W, Rng& rng, double s, bool open_room
         ps.elevation = round2(b.height + ps.h / 2 + 0.01);
         ps.on = "furniture top";
       } else {
-        ps.pos = b.c + n_in * (depth / 2);
+        ps.pos = b.c + n_in * (b.sx / 2 + 0.001);
         ps.elevation =
             round2(std::clamp(rng.uniform(0.5, 1.2), ps.h / 2 + 0.1, b.height - ps.h / 2 - 0.05));
         ps.on = "furniture face";
       }
-      b.height = round2(b.height);
       addBox(W, b);
       return ps;
     }
@@ -642,7 +654,7 @@ void addClutter(World& W, Rng& rng, const std::string& family) {
       b.yaw = 0;
       if (!fits(W, b, 1.0)) continue;
     }
-    b.height = round2(b.height);
+    quantise(b);
     addBox(W, b);
     ++k;
   }
@@ -721,6 +733,7 @@ void addObstacleInTheWay(World& W, Rng& rng, Json& meta) {
     b.yaw = std::atan2(d.y(), d.x());
     b.c = p + rng.uniform(-0.3, 0.3) * rot(d, M_PI / 2);
     b.height = round2(rng.uniform(0.5, 1.0));
+    quantise(b);
     // Inside its room with the robot's way round it on at least one side.
     bool ok = true;
     for (const auto& q : b.samples()) ok = ok && W.L.idAt(q) == W.L.idAt(b.c) && !W.L.occupiedAt(q);

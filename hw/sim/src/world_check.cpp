@@ -21,6 +21,16 @@ std::string fmtM(double x) {
   return b;
 }
 
+// Depths under 1 cm in millimetres ("0.005 m" would print as 0.00 m).
+std::string fmtMm(double x) {
+  char b[32];
+  if (x < 0.01)
+    std::snprintf(b, sizeof b, "%.0f mm", x * 1000);
+  else
+    std::snprintf(b, sizeof b, "%.2f m", x);
+  return b;
+}
+
 std::string idx(const char* what, size_t i) {
   return std::string(what) + "[" + std::to_string(i) + "]";
 }
@@ -159,7 +169,7 @@ std::vector<WorldIssue> checkWorldGeometry(const World& w, const WorldCheckParam
         // top) may have its centre over the footprint.
         const bool above = bottom >= s.top - p.inside_m;
         if (d < -p.inside_m && !above) {
-          out.push_back(error(f + ".position", "'" + l.id + "' is " + fmtM(-d) + " m inside " +
+          out.push_back(error(f + ".position", "'" + l.id + "' is " + fmtMm(-d) + " inside " +
                                                    named(s.field, s.name) +
                                                    ": the photo would be hidden"));
           reported = true;

@@ -27,7 +27,7 @@ struct WorldIssue {
 /// photo's centre may sit before it is hidden (the renderer moves faces 4 mm out).
 struct WorldCheckParams {
   double on_face_m = 0.05;        // [m] a photo centre within this of a face is on that face
-  double inside_m = 0.01;         // [m] a photo centre deeper than this in a solid is inside it
+  double inside_m = 0.004;        // [m] deeper than the renderer's 4 mm offset: hidden
   double overlap_m = 0.03;        // [m] solids overlapping deeper than this overlap (a shelf
                                   // drawn 1-2 cm into the wall it stands against does not)
   double heading_warn_deg = 30;   // [deg] start heading vs sketch disagreement: warning
