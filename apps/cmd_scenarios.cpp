@@ -160,7 +160,9 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
       .flag("reuse", "with --run: keep runs already in <out>/runs/<name>/summary.json")
       .option("jobs", "runs in parallel (child processes)", "2")
       .option("model", "landmark model (.slm); default: the demo set's cached model")
-      .option("landmarks", "landmark set folder (classes of the generated landmarks)")
+      .option("landmarks",
+              "landmark set folder the landmarks' classes are drawn from (default: the demo "
+              "set; with another set give --model trained on it)")
       .option("max-time", "give up each run after this many simulated seconds", "300");
   if (!args.parse(argv)) return 0;
   if (args.get("generate").empty()) throw InputError("--generate N is required");
