@@ -75,3 +75,19 @@ file(WRITE ${WORK}/bad.world.json [=[
 ]=])
 expect(2 "bad.world.json: landmarks\\[0\\].position: 'L1' is 0.03 m inside walls\\[0\\] \\('south'\\)"
        sim map --world ${WORK}/bad.world.json -o ${WORK}/bad.png)
+# The run's own checks, before anything moves: a landmark class the model does not know, and a
+# start heading the sketch contradicts (turned round), each exit 2 naming the field.
+file(READ ${WORK}/a/corridor-7.world.json wj)
+string(JSON cls SET "${wj}" landmarks 0 class "\"Nope-Juice\"")
+file(WRITE ${WORK}/bad-class.world.json "${cls}")
+expect(2 "bad-class.world.json: landmarks\\[0\\].class: 'Nope-Juice' is not in the landmark set"
+       run --world ${WORK}/bad-class.world.json --sketch ${WORK}/a/corridor-7.sketch.json
+       --max-time 1 --out ${WORK}/bad-class)
+string(JSON yaw GET "${wj}" start yaw_deg)
+string(REGEX REPLACE "\\..*" "" yaw "${yaw}")  # math() is integer only
+math(EXPR back "${yaw} + 180" OUTPUT_FORMAT DECIMAL)
+string(JSON turned SET "${wj}" start yaw_deg "${back}")
+file(WRITE ${WORK}/turned.world.json "${turned}")
+expect(2 "turned.world.json: start.yaw_deg: .* disagrees with the sketch"
+       run --world ${WORK}/turned.world.json --sketch ${WORK}/a/corridor-7.sketch.json
+       --max-time 1 --out ${WORK}/turned)
