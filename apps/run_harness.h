@@ -84,6 +84,19 @@ std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.
 Json runNavigation(const RunOptions& options);
 
+/// The verdict of a simulated run (doc/navigation.md): success means the robot's centre is in
+/// the goal region and nothing was hit (ground truth), whatever the executive concluded; the
+/// executive's own verdict goes beside it (summary.json "executive_success"). The reason says
+/// which applied: a collision, a route completed short of the goal, the goal reached (with the
+/// executive's failure when it failed there), or the executive's reason.
+struct RunVerdict {
+  bool success = false;
+  std::string reason;
+};
+RunVerdict judgeSimulatedRun(bool executive_succeeded, const std::string& executive_reason,
+                             bool at_goal, bool collided, const std::string& collided_with,
+                             double to_goal_m);
+
 /// How far the sketch alone puts the goal [m]: where the navigation's refit of `route`, with
 /// every sketched landmark fixed exactly where `w` has it (nav::goalFromExactFixes, outlier
 /// gate `fit_outlier_m`), maps the drawn goal, from the goal's centre. None when fewer than two

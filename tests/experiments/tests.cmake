@@ -3,7 +3,7 @@
 set(SN $<TARGET_FILE:sketchnav>)
 set(EXP_DIR ${CMAKE_CURRENT_SOURCE_DIR}/experiments)
 set(EXP_WORK ${CMAKE_CURRENT_BINARY_DIR}/experiments-work)
-foreach(t replay_rendered tune_reproducible short_run bad_input)
+foreach(t replay_rendered tune_reproducible short_run bad_input scenarios_slice)
   add_test(NAME experiments_${t}
     COMMAND ${CMAKE_COMMAND} -DSN=${SN} -DWORK=${EXP_WORK}/${t} -DSHARE=${PROJECT_SOURCE_DIR}/share
             -P ${EXP_DIR}/${t}.cmake)
@@ -13,7 +13,8 @@ endforeach()
 # Unit tests of the variant generator and the plot writer (fast, no simulation).
 sketchnav_add_test(test_experiments
   SOURCES ${EXP_DIR}/test_experiments.cpp ${PROJECT_SOURCE_DIR}/apps/exp_variants.cpp
-          ${PROJECT_SOURCE_DIR}/apps/plot.cpp
+          ${PROJECT_SOURCE_DIR}/apps/plot.cpp ${PROJECT_SOURCE_DIR}/apps/scenario_gen.cpp
+          ${EXP_DIR}/test_scenarios.cpp
   LINK sketchnav::core sketchnav::sim sketchnav::mapsketch opencv_imgproc
   LABELS experiments)
 if(TARGET test_experiments)

@@ -65,6 +65,21 @@ double threadCpuSeconds() {
   return static_cast<double>(ts.tv_sec) + 1e-9 * static_cast<double>(ts.tv_nsec);
 }
 
+/// MRPT's differential-drive kinematics, stepped once per substep. MRPT integrates in
+/// "firmware" periods and, with its default 0.5 ms period, a 10 ms step runs 20 or 21 periods
+/// depending on rounding (a few % too much motion). With the period set to the substep and a
+/// call of half a substep, each call is exactly one period (checked by the tests).
+class Vehicle : public mrpt::kinematics::CVehicleSimul_DiffDriven {
+ public:
+  explicit Vehicle(double substep) : substep_(substep) { m_firmware_control_period = substep; }
+  void step() { simulateOneTimeStep(0.5 * substep_); }
+
+ private:
+  double substep_;
+};
+
+}  // namespace
+
 PedestrianState pedestrianAt(const Pedestrian& p, double t) {
   PedestrianState st;
   st.name = p.name;
@@ -100,21 +115,6 @@ PedestrianState pedestrianAt(const Pedestrian& p, double t) {
   st.position = pts.back();
   return st;
 }
-
-/// MRPT's differential-drive kinematics, stepped once per substep. MRPT integrates in
-/// "firmware" periods and, with its default 0.5 ms period, a 10 ms step runs 20 or 21 periods
-/// depending on rounding (a few % too much motion). With the period set to the substep and a
-/// call of half a substep, each call is exactly one period (checked by the tests).
-class Vehicle : public mrpt::kinematics::CVehicleSimul_DiffDriven {
- public:
-  explicit Vehicle(double substep) : substep_(substep) { m_firmware_control_period = substep; }
-  void step() { simulateOneTimeStep(0.5 * substep_); }
-
- private:
-  double substep_;
-};
-
-}  // namespace
 
 // ---------------------------------------------------------------------------------------
 struct Simulator::Impl {

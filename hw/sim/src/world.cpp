@@ -12,6 +12,7 @@
 #include "sketchnav/core/input_file.h"
 #include "sketchnav/core/json_io.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/sim/world_check.h"
 
 namespace fs = std::filesystem;
 
@@ -455,6 +456,10 @@ World worldFromJson(const Json& j, const std::string& origin, const std::string&
              "robot (radius " + std::to_string(w.robot.radius) + " m) overlaps '" + p.name + "'");
   for (const auto& c : solids.circles)
     if ((s - c.c).norm() - c.r < w.robot.radius) r.fail("start", "robot overlaps '" + c.name + "'");
+  // Plausibility (world_check.h): a photo hidden in a wall, furniture standing in one.
+  // Warnings are left to the caller (checkWorldGeometry again) to report.
+  for (const auto& issue : checkWorldGeometry(w))
+    if (issue.isError()) throw InputError(issue.text(origin));
   return w;
 }
 

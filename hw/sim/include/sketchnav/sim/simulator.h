@@ -91,6 +91,9 @@ struct PedestrianState {
   double radius = 0.25;            // [m]
 };
 
+/// Where pedestrian `p` is at simulated time `t` (its position is a function of time only).
+PedestrianState pedestrianAt(const Pedestrian& p, double t);
+
 struct TrajectorySample {
   double t = 0.0;           // [s] simulated
   hw::Pose2D truth;         // world frame
