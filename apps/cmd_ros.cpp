@@ -10,9 +10,11 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/nav/events.h"
 #include "sketchnav/ros/bag.h"
 #include "sketchnav/ros/node.h"
 #include "sketchnav/ros/sim_bridge.h"
+#include "sketchnav/servo/turn_law.h"
 
 namespace sketchnav::app {
 namespace {
@@ -157,16 +159,16 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     o.config = c;
     o.out_dir = args.get("out").empty() ? "" : makeOutputDir(args.get("out"));
     o.progress = true;
-    o.on_event = [&](const Json& e) {
+    o.on_event = [&](const nav::NavEvent& e) {
       // The route starts: one command, so a simulator holding its time at 0 starts too.
-      if (e.value("type", "") == "start") ros::sendZeroCommand();
-      events.publish(e);
+      if (e.as<nav::event::Start>()) ros::sendZeroCommand();
+      events.publish(e.toJson());
     };
     o.on_tick = [&](const nav::TelemetryRow& r) {
       state.publish({{"t", r.t},
                      {"section", r.section},
-                     {"mode", r.mode},
-                     {"turn", r.turn},
+                     {"mode", nav::toString(r.mode)},
+                     {"turn", servo::toString(r.turn)},
                      {"landmark", r.landmark},
                      {"v", r.v_cmd},
                      {"w", r.w_cmd},

@@ -12,6 +12,7 @@
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/mapsketch/route.h"
 
 namespace sketchnav::app {
 namespace {
@@ -85,20 +86,6 @@ std::vector<std::string> idsOf(const Json& world) {
 
 V2 toCanvas(const V2& w) {
   return {32.0 + 52.0 * w.x(), 698.0 - 52.0 * w.y()};
-}
-
-// Arc length along `poly` of the point closest to p.
-double arcPosition(const V2& p, const std::vector<V2>& poly) {
-  double best = 1e300, best_s = 0, s = 0;
-  for (size_t i = 0; i + 1 < poly.size(); ++i) {
-    const V2 a = poly[i], d = poly[i + 1] - a;
-    const double L = d.norm();
-    const double t = L > 0 ? std::clamp((p - a).dot(d) / (L * L), 0.0, 1.0) : 0.0;
-    const double dist = (a + t * d - p).norm();
-    if (dist < best) best = dist, best_s = s + t * L;
-    s += L;
-  }
-  return best_s;
 }
 
 // The distance from `goal` to the centre of the nearest open door within 1.5 m, rounded to
@@ -247,7 +234,7 @@ Json makeSketch(const Variant& v, const SketchNoise& noise, std::uint64_t seed) 
     const std::string id = l.value("id", "");
     if (std::find(v.sketched.begin(), v.sketched.end(), id) == v.sketched.end()) continue;
     const V2 p(l["position"][0].get<double>(), l["position"][1].get<double>());
-    ls.push_back({id, l.value("class", ""), p, arcPosition(p, v.drawn_path)});
+    ls.push_back({id, l.value("class", ""), p, mapsketch::closestOnPolyline(p, v.drawn_path).arc});
   }
   std::stable_sort(ls.begin(), ls.end(), [](const L& a, const L& b) { return a.s < b.s; });
   Json lms = Json::array();

@@ -140,18 +140,6 @@ struct RouteToWorld {
   }
 };
 
-double distToPolyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& poly) {
-  double best = 1e300;
-  for (size_t i = 0; i + 1 < poly.size(); ++i) {
-    const Eigen::Vector2d a = poly[i], d = poly[i + 1] - a;
-    const double L2 = d.squaredNorm();
-    const double t = L2 > 0 ? std::clamp((p - a).dot(d) / L2, 0.0, 1.0) : 0.0;
-    best = std::min(best, (a + t * d - p).norm());
-  }
-  if (poly.size() == 1) best = (poly[0] - p).norm();
-  return best;
-}
-
 class RunObserver final : public nav::ExecutiveObserver {
  public:
   RunObserver(const std::string& out, bool progress, sim::Simulator* sim, int sections)
@@ -704,7 +692,7 @@ Json runNavigation(const RunOptions& o) {
   if (!traj.empty()) {
     double sum = 0, mx = 0;
     for (const auto& p : traj) {
-      const double d = distToPolyline({p.x, p.y}, sketched);
+      const double d = mapsketch::closestOnPolyline({p.x, p.y}, sketched).distance;
       sum += d;
       mx = std::max(mx, d);
     }

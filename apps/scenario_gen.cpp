@@ -110,18 +110,6 @@ std::pair<V2, V2> along(const std::vector<V2>& poly, double s) {
   }
   return {poly.back(), V2(1, 0)};
 }
-double arcOf(const V2& p, const std::vector<V2>& poly) {
-  double best = 1e300, best_s = 0, s = 0;
-  for (size_t i = 0; i + 1 < poly.size(); ++i) {
-    const V2 a = poly[i], d = poly[i + 1] - a;
-    const double L = d.norm();
-    const double t = L > 0 ? std::clamp((p - a).dot(d) / (L * L), 0.0, 1.0) : 0.0;
-    const double dist = (a + t * d - p).norm();
-    if (dist < best) best = dist, best_s = s + t * L;
-    s += L;
-  }
-  return best_s;
-}
 
 struct Rect {
   double x0, y0, x1, y1;
@@ -937,7 +925,8 @@ Drawn drawSketch(const World& W, const std::vector<Poster>& remembered, const st
   std::vector<size_t> order(remembered.size());
   for (size_t i = 0; i < order.size(); ++i) order[i] = i;
   std::stable_sort(order.begin(), order.end(), [&](size_t a, size_t b) {
-    return arcOf(remembered[a].pos, W.L.route) < arcOf(remembered[b].pos, W.L.route);
+    return mapsketch::closestOnPolyline(remembered[a].pos, W.L.route).arc <
+           mapsketch::closestOnPolyline(remembered[b].pos, W.L.route).arc;
   });
   Json lms = Json::array();
   V2 prev = W.L.route.front();

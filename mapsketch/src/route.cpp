@@ -1,5 +1,6 @@
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <numeric>
 #include <sstream>
 
@@ -48,6 +49,22 @@ void RouteParams::validate() const {
           "must be in (0, 10] m");
   require(ahead_angle_deg >= 0 && ahead_angle_deg < 90, "route.ahead_angle_deg",
           "must be in [0, 90)");
+}
+
+PolylinePoint closestOnPolyline(const Eigen::Vector2d& p,
+                                const std::vector<Eigen::Vector2d>& poly) {
+  PolylinePoint best{std::numeric_limits<double>::infinity(), 0};
+  if (poly.size() == 1) return {(poly[0] - p).norm(), 0};
+  double s = 0;
+  for (size_t i = 0; i + 1 < poly.size(); ++i) {
+    const Eigen::Vector2d a = poly[i], d = poly[i + 1] - a;
+    const double L2 = d.squaredNorm(), L = std::sqrt(L2);
+    const double t = L2 > 0 ? std::clamp((p - a).dot(d) / L2, 0.0, 1.0) : 0.0;
+    const double dist = (a + t * d - p).norm();
+    if (dist < best.distance) best = {dist, s + t * L};
+    s += L;
+  }
+  return best;
 }
 
 std::vector<int> simplifyPolyline(const std::vector<Eigen::Vector2d>& pts, double tolerance) {

@@ -52,6 +52,24 @@ TEST(Simplify, ShortInputsAreKept) {
   EXPECT_EQ(simplifyPolyline({{0, 0}, {1, 1}}, 1).size(), 2u);
 }
 
+TEST(ClosestOnPolyline, DistanceAndArcLengthOfTheNearestPoint) {
+  const std::vector<Eigen::Vector2d> l = {{0, 0}, {4, 0}, {4, 3}};
+  auto at = closestOnPolyline({2, 1}, l);  // above the first leg
+  EXPECT_DOUBLE_EQ(at.distance, 1);
+  EXPECT_DOUBLE_EQ(at.arc, 2);
+  at = closestOnPolyline({5, 2}, l);  // beside the second leg
+  EXPECT_DOUBLE_EQ(at.distance, 1);
+  EXPECT_DOUBLE_EQ(at.arc, 6);
+  at = closestOnPolyline({-3, -4}, l);  // before the start: the start
+  EXPECT_DOUBLE_EQ(at.distance, 5);
+  EXPECT_DOUBLE_EQ(at.arc, 0);
+  at = closestOnPolyline({4, 10}, l);  // past the end: the end
+  EXPECT_DOUBLE_EQ(at.distance, 7);
+  EXPECT_DOUBLE_EQ(at.arc, 7);
+  EXPECT_DOUBLE_EQ(closestOnPolyline({3, 4}, {{0, 0}}).distance, 5);
+  EXPECT_TRUE(std::isinf(closestOnPolyline({0, 0}, {}).distance));
+}
+
 TEST(ScaleFit, ConsistentDistancesGiveExactScaleAndZeroResidual) {
   const auto f = fitScale({100, 200, 50}, {2, 4, 1});
   EXPECT_NEAR(f.scale, 0.02, 1e-12);

@@ -93,6 +93,14 @@ Route toRoute(const Sketch& sketch, const RouteParams& params = {});
 /// always kept), increasing.
 std::vector<int> simplifyPolyline(const std::vector<Eigen::Vector2d>& pts, double tolerance);
 
+/// The point of a polyline closest to a point: how far it is and its arc length from the
+/// polyline's start (the polyline's units). One point: its distance, arc 0; none: infinite.
+struct PolylinePoint {
+  double distance = 0;
+  double arc = 0;
+};
+PolylinePoint closestOnPolyline(const Eigen::Vector2d& p, const std::vector<Eigen::Vector2d>& poly);
+
 /// Result of fitting metres-per-pixel to the user's distances.
 struct ScaleFit {
   double scale = 0;                    // [m / canvas px]
