@@ -66,3 +66,8 @@ endif()
 if(NOT err MATCHES "skipped unreadable frame.*declares 30000 x 30000")
   message(FATAL_ERROR "no warning naming the bomb frame: ${err}")
 endif()
+# Unknown device URI parameters are errors like unknown settings (issue 28).
+expect(2 "camera URI 'folder:///x\\?fsp=10': unknown parameter 'fsp' \\(did you mean 'fps'\\?\\)"
+       probe folder:///x?fsp=10)
+expect(2 "camera URI 'sim://lab\\?sed=3': unknown parameter 'sed' \\(did you mean 'seed'\\?\\)"
+       probe sim://lab?sed=3)
