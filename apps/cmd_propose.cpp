@@ -19,6 +19,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/hw/image_file.h"
 #include "sketchnav/landmarks/baselines.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/voc.h"
@@ -179,9 +180,8 @@ int runEval(const Args& args, GlobalOptions& g, const ObjectnessParams& params) 
 
 int runImage(const Args& args, GlobalOptions& g, const ObjectnessParams& params) {
   const std::string path = args.positional().front();
-  if (!fs::exists(path)) throw InputError("sketchnav propose: " + path + ": no such file");
-  const cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-  if (img.empty()) throw InputError("sketchnav propose: " + path + ": not a readable image");
+  // Regular files only (a FIFO would block), the header's pixel count bounded before decoding.
+  const cv::Mat img = hw::readImageFile(path, "sketchnav propose: image");
   const int n = args.getInt("windows");
   if (n <= 0) throw InputError("sketchnav propose: --windows must be a positive count");
   const int draw = std::min(n, args.getInt("draw"));

@@ -16,6 +16,7 @@
 #include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/hw/image_file.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
@@ -241,9 +242,11 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
       ++done;
       if (!(g.json && !g.verbose))
         std::cerr << "\rrecognise: " << done << "/" << total << std::flush;
-      cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-      if (img.empty()) {
-        log::warn("recognise", "skipping unreadable image", {{"file", path}});
+      cv::Mat img;
+      try {
+        img = hw::readImageFile(path, "image");
+      } catch (const InputError& e) {
+        log::warn("recognise", "skipping unreadable image", {{"file", path}, {"error", e.what()}});
         ++failed;
         continue;
       }
@@ -439,11 +442,15 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
   Json out = Json::array();
   int unreadable = 0;
   for (const auto& path : args.positional()) {
-    cv::Mat img = cv::imread(path, cv::IMREAD_COLOR);
-    if (!img.empty()) img = runner.prepare(img);
-    if (img.empty()) {
-      if (args.positional().size() == 1) throw InputError(path + ": not a readable image");
-      log::warn("recognise", "skipping unreadable image", {{"file", path}});
+    // Regular files only (a FIFO would block), the header's pixel count bounded before decoding.
+    cv::Mat img;
+    try {
+      img = runner.prepare(hw::readImageFile(path, "sketchnav recognise: image"));
+      if (img.empty())
+        throw InputError("sketchnav recognise: image '" + path + "': empty after resizing");
+    } catch (const InputError& e) {
+      if (args.positional().size() == 1) throw;
+      log::warn("recognise", "skipping unreadable image", {{"file", path}, {"error", e.what()}});
       ++unreadable;
       continue;
     }

@@ -12,6 +12,7 @@
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/hw/image_file.h"
 
 namespace fs = std::filesystem;
 
@@ -95,10 +96,12 @@ FolderCamera::FolderCamera(const std::string& dir, FolderCameraParams params, st
   if (files_.empty()) throw InputError("image folder '" + dir + "' holds no images");
   // Intrinsics come from the first readable frame's size.
   for (const auto& f : files_) {
-    cv::Mat m = cv::imread(f, cv::IMREAD_COLOR);
-    if (!m.empty()) {
+    try {
+      const cv::Mat m = readImageFile(f, "frame", ImageMode::Unchanged);
       intrinsics_ = Intrinsics::fromFov(m.cols, m.rows, params_.hfov_deg * M_PI / 180.0);
       return;
+    } catch (const InputError&) {
+      // grab() skips it with a warning too
     }
   }
   throw InputError("image folder '" + dir + "': none of its " + std::to_string(files_.size()) +
@@ -114,14 +117,12 @@ GrabStatus FolderCamera::grab(Frame& frame, double) {
     const std::string& path = files_[next_++];
     cv::Mat m;
     try {
-      m = cv::imread(path, cv::IMREAD_UNCHANGED);
-    } catch (const cv::Exception& e) {
-      m.release();
-    }
-    if (m.empty()) {
+      // Regular files only, the pixel bound checked on the header before decoding.
+      m = readImageFile(path, "frame", ImageMode::Unchanged);
+    } catch (const InputError& e) {
       ++stats_.dropped;
-      stats_.last_error = "cannot decode '" + path + "'";
-      log::warn("camera.folder", "skipped unreadable frame", {{"file", path}});
+      stats_.last_error = e.what();
+      log::warn("camera.folder", "skipped unreadable frame", {{"file", path}, {"error", e.what()}});
       continue;
     }
     frame.image = toBgr8(m);

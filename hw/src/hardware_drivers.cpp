@@ -77,37 +77,59 @@ std::unique_ptr<Base> stopBaseWhileCameraIsLost(std::unique_ptr<Base> base, Came
 
 void registerHardwareDrivers() {
   Registry& r = Registry::instance();
-  r.addCamera("aravis", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
-    AravisParams p;
-    applyConfig(p, ctx.config, "camera.aravis");
-    p.applyUri(uri);
-    p.validate();
-    return std::make_unique<AravisCamera>(uri.authority, p, ctx.clock, uri.text);
-  });
-  r.addBase("dani", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
-    return std::make_unique<DaniBase>(daniLink(uri, ctx));
-  });
-  r.addCamera("rawlog", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
-    if (uri.path.empty())
-      throw InputError("camera URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
-    return std::make_unique<RawlogCamera>(
-        uri.path, uri.param("label", ""), uri.text,
-        uri.paramInt("realtime", 0) != 0 ? (ctx.clock ? ctx.clock : std::make_shared<SteadyClock>())
-                                         : nullptr);
-  });
-  r.addBase("rawlog", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
-    if (uri.path.empty())
-      throw InputError("base URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
-    return std::make_unique<RawlogBase>(uri.path, ctx.clock, uri.param("label", "ODOMETRY"),
-                                        uri.text);
-  });
+  // What daniLink() reads from a dani:// URI.
+  const Registry::Parameters kDaniParameters = {"link_timeout_s", "connect_timeout_s", "resume",
+                                                "secret_file"};
+  r.addCamera("aravis",
+              [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
+                AravisParams p;
+                applyConfig(p, ctx.config, "camera.aravis");
+                p.applyUri(uri);
+                p.validate();
+                return std::make_unique<AravisCamera>(uri.authority, p, ctx.clock, uri.text);
+              },
+              {"pixel_format", "width", "height", "fps", "exposure_us", "gain_db", "buffers",
+               "packet_size", "resend", "hfov_deg", "lost_timeout_s", "reconnect_period_s"});
+  r.addBase(
+      "dani",
+      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
+        return std::make_unique<DaniBase>(daniLink(uri, ctx));
+      },
+      kDaniParameters);
+  r.addCamera(
+      "rawlog",
+      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
+        if (uri.path.empty())
+          throw InputError("camera URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
+        return std::make_unique<RawlogCamera>(
+            uri.path, uri.param("label", ""), uri.text,
+            uri.paramInt("realtime", 0) != 0
+                ? (ctx.clock ? ctx.clock : std::make_shared<SteadyClock>())
+                : nullptr);
+      },
+      {"label", "realtime"});
+  r.addBase(
+      "rawlog",
+      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Base> {
+        if (uri.path.empty())
+          throw InputError("base URI '" + uri.text + "': expected rawlog:///path/file.rawlog");
+        return std::make_unique<RawlogBase>(uri.path, ctx.clock, uri.param("label", "ODOMETRY"),
+                                            uri.text);
+      },
+      {"label"});
+  // laser://DRIVER?key=value: the query is the MRPT driver's own configuration section.
   r.addRange("laser",
-             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); });
+             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); },
+             {Registry::kAnyParameter});
   r.addRange("rawlog",
-             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); });
-  r.addRange("dani", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<RangeSensor> {
-    return std::make_unique<DaniSonar>(daniLink(uri, ctx));
-  });
+             [](const Uri& uri, DeviceContext& ctx) { return createLaserFromUri(uri, ctx.clock); },
+             {"realtime", "loop", "label"});
+  r.addRange(
+      "dani",
+      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<RangeSensor> {
+        return std::make_unique<DaniSonar>(daniLink(uri, ctx));
+      },
+      kDaniParameters);
 }
 
 }  // namespace sketchnav::hw

@@ -1,8 +1,10 @@
 #include "sketchnav/hw/registry.h"
 
+#include <algorithm>
 #include <cmath>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/hw/file_cameras.h"
 #include "sketchnav/hw/hardware_drivers.h"
 
@@ -23,16 +25,17 @@ template <class Map>
 auto create(const Map& m, const char* kind, const std::string& text, DeviceContext& ctx,
             std::mutex& mutex) {
   const Uri uri = Uri::parse(text);
-  typename Map::mapped_type factory;
+  typename Map::mapped_type entry;
   {
     std::lock_guard<std::mutex> lock(mutex);
     auto it = m.find(uri.scheme);
     if (it == m.end())
       throw InputError(std::string("unknown ") + kind + " URI scheme '" + uri.scheme + "' in '" +
                        text + "' (known: " + joined(schemesOf(m)) + ")");
-    factory = it->second;
+    entry = it->second;
   }
-  return factory(uri, ctx);
+  requireKnownParameters(uri, kind, entry.params);
+  return entry.factory(uri, ctx);
 }
 }  // namespace
 
@@ -46,22 +49,47 @@ Intrinsics Intrinsics::fromFov(int width, int height, double hfov_rad) {
   return k;
 }
 
+namespace {
+// The known parameter the unknown one most likely meant: one it abbreviates ("hfov" for
+// "hfov_deg"), else the closest by edit distance ("fsp" for "fps").
+std::string closestParameter(const std::string& key, const Registry::Parameters& known) {
+  for (const auto& k : known)
+    if (!key.empty() && k.size() > key.size() && k.compare(0, key.size(), key) == 0) return k;
+  return closestKey(key, known);
+}
+}  // namespace
+
+void requireKnownParameters(const Uri& uri, const std::string& kind,
+                            const Registry::Parameters& known) {
+  if (std::find(known.begin(), known.end(), Registry::kAnyParameter) != known.end()) return;
+  for (const auto& [key, value] : uri.query) {
+    if (std::find(known.begin(), known.end(), key) != known.end()) continue;
+    std::string msg = kind + " URI '" + clipForMessage(uri.text, 200) + "': unknown parameter '" +
+                      clipForMessage(key) + "'";
+    if (known.empty())
+      msg += " (" + uri.scheme + ":// takes no parameters)";
+    else
+      msg += " (did you mean '" + closestParameter(key, known) + "'?)";
+    throw InputError(msg);
+  }
+}
+
 Registry& Registry::instance() {
   static Registry r;
   return r;
 }
 
-void Registry::addCamera(const std::string& s, CameraFactory f) {
+void Registry::addCamera(const std::string& s, CameraFactory f, Parameters params) {
   std::lock_guard<std::mutex> lock(mutex_);
-  cameras_[s] = std::move(f);
+  cameras_[s] = {std::move(f), std::move(params)};
 }
-void Registry::addBase(const std::string& s, BaseFactory f) {
+void Registry::addBase(const std::string& s, BaseFactory f, Parameters params) {
   std::lock_guard<std::mutex> lock(mutex_);
-  bases_[s] = std::move(f);
+  bases_[s] = {std::move(f), std::move(params)};
 }
-void Registry::addRange(const std::string& s, RangeFactory f) {
+void Registry::addRange(const std::string& s, RangeFactory f, Parameters params) {
   std::lock_guard<std::mutex> lock(mutex_);
-  ranges_[s] = std::move(f);
+  ranges_[s] = {std::move(f), std::move(params)};
 }
 
 std::unique_ptr<Camera> Registry::createCamera(const std::string& uri, DeviceContext& ctx) const {
@@ -90,23 +118,30 @@ std::vector<std::string> Registry::rangeSchemes() const {
 
 void registerBuiltinDrivers() {
   Registry& r = Registry::instance();
-  r.addCamera("folder", [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
-    if (uri.path.empty())
-      throw InputError("camera URI '" + uri.text + "': expected folder:///absolute/path");
-    FolderCameraParams p;
-    applyConfig(p, ctx.config, "camera.folder");
-    p.fps = uri.paramDouble("fps", p.fps);
-    p.loop = uri.paramInt("loop", p.loop ? 1 : 0) != 0;
-    p.hfov_deg = uri.paramDouble("hfov_deg", p.hfov_deg);
-    p.validate();
-    return std::make_unique<FolderCamera>(uri.path, p, uri.text);
-  });
-  r.addCamera("video", [](const Uri& uri, DeviceContext&) -> std::unique_ptr<Camera> {
-    const std::string source = uri.path.empty() ? uri.authority : uri.path;
-    if (source.empty())
-      throw InputError("camera URI '" + uri.text + "': expected video:///file or video://INDEX");
-    return std::make_unique<VideoCamera>(source, uri.paramDouble("hfov_deg", 60.0), uri.text);
-  });
+  r.addCamera(
+      "folder",
+      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
+        if (uri.path.empty())
+          throw InputError("camera URI '" + uri.text + "': expected folder:///absolute/path");
+        FolderCameraParams p;
+        applyConfig(p, ctx.config, "camera.folder");
+        p.fps = uri.paramDouble("fps", p.fps);
+        p.loop = uri.paramInt("loop", p.loop ? 1 : 0) != 0;
+        p.hfov_deg = uri.paramDouble("hfov_deg", p.hfov_deg);
+        p.validate();
+        return std::make_unique<FolderCamera>(uri.path, p, uri.text);
+      },
+      {"fps", "loop", "hfov_deg"});
+  r.addCamera("video",
+              [](const Uri& uri, DeviceContext&) -> std::unique_ptr<Camera> {
+                const std::string source = uri.path.empty() ? uri.authority : uri.path;
+                if (source.empty())
+                  throw InputError("camera URI '" + uri.text +
+                                   "': expected video:///file or video://INDEX");
+                return std::make_unique<VideoCamera>(source, uri.paramDouble("hfov_deg", 60.0),
+                                                     uri.text);
+              },
+              {"hfov_deg"});
   registerHardwareDrivers();
 }
 

@@ -58,3 +58,51 @@ TEST(Registry, CustomFactoriesAreUsedByScheme) {
   ASSERT_TRUE(r->read(s));
   EXPECT_EQ(s.ranges.size(), 1u);
 }
+
+// Issue 28: an unknown URI parameter is an error like an unknown setting, before the device
+// is opened (folder:///x?fsp=10 ran at the default 30 fps).
+TEST(Registry, UnknownUriParameterNamesItAndTheClosestKnownOne) {
+  registerBuiltinDrivers();
+  const std::string dir = test::tempDir("registry-params");
+  cv::imwrite(dir + "/1.png", cv::Mat(10, 20, CV_8UC3, cv::Scalar(1, 2, 3)));
+  DeviceContext ctx;
+  auto message = [&](const std::string& uri) -> std::string {
+    try {
+      Registry::instance().createCamera(uri, ctx);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  EXPECT_EQ(
+      message("folder://" + dir + "?fsp=10"),
+      "camera URI 'folder://" + dir + "?fsp=10': unknown parameter 'fsp' (did you mean 'fps'?)");
+  EXPECT_EQ(message("folder://" + dir + "?fps=4&hfov=70"),
+            "camera URI 'folder://" + dir +
+                "?fps=4&hfov=70': unknown parameter 'hfov' (did you mean 'hfov_deg'?)");
+  // Checked before the factory runs: the folder need not exist for the parameter to be named.
+  EXPECT_NE(message("folder:///nonexistent-sketchnav?lop=1")
+                .find("unknown parameter 'lop' (did you mean 'loop'?)"),
+            std::string::npos);
+  EXPECT_EQ(message("folder://" + dir + "?fps=4&loop=1&hfov_deg=70"), "");
+  // A scheme registered without parameters takes none; "*" lets any key through.
+  struct NullRange final : RangeSensor {
+    bool read(RangeScan&) override { return false; }
+    DeviceStats stats() const override { return {}; }
+    std::string uri() const override { return "bare://"; }
+  };
+  Registry::instance().addRange(
+      "bare", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); });
+  Registry::instance().addRange(
+      "open", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); },
+      {Registry::kAnyParameter});
+  try {
+    Registry::instance().createRange("bare://x?rate=3", ctx);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "range sensor URI 'bare://x?rate=3': unknown parameter 'rate' (bare:// takes no "
+                 "parameters)");
+  }
+  EXPECT_NO_THROW(Registry::instance().createRange("open://x?rate=3&anything=1", ctx));
+}

@@ -165,9 +165,11 @@ void registerBagDriver() {
   static std::once_flag once;
   std::call_once(once, [] {
     hw::Registry::instance().addCamera(
-        "bag", [](const Uri& u, hw::DeviceContext&) -> std::unique_ptr<hw::Camera> {
+        "bag",
+        [](const Uri& u, hw::DeviceContext&) -> std::unique_ptr<hw::Camera> {
           return std::make_unique<BagCamera>(u);
-        });
+        },
+        {"topic", "info", "hfov_deg"});
   });
 }
 

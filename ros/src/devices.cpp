@@ -531,23 +531,30 @@ void registerDrivers() {
   static std::once_flag once;
   std::call_once(once, [] {
     auto& r = hw::Registry::instance();
-    r.addCamera("ros", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
-      ctx.clock = clock();
-      return std::make_unique<RosCamera>(topicParam(u, "topic", "image_raw"),
-                                         u.param("info", "camera_info"));
-    });
-    r.addBase("ros", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
-      ctx.clock = clock();
-      return std::make_unique<RosBase>(topicParam(u, "cmd_vel", "cmd_vel"),
-                                       topicParam(u, "odom", "odom"));
-    });
-    r.addRange("ros", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::RangeSensor> {
-      ctx.clock = clock();
-      const std::string kind = u.param("kind", u.authority.empty() ? "laser" : u.authority);
-      if (kind == "laser") return std::make_unique<RosLaser>(topicParam(u, "topic", "scan"));
-      if (kind == "sonar") return std::make_unique<RosSonar>(topicParam(u, "topic", "sonar"));
-      throw InputError(u.text + ": unknown range sensor kind '" + kind + "' (laser or sonar)");
-    });
+    r.addCamera("ros",
+                [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
+                  ctx.clock = clock();
+                  return std::make_unique<RosCamera>(topicParam(u, "topic", "image_raw"),
+                                                     u.param("info", "camera_info"));
+                },
+                {"topic", "info"});
+    r.addBase("ros",
+              [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
+                ctx.clock = clock();
+                return std::make_unique<RosBase>(topicParam(u, "cmd_vel", "cmd_vel"),
+                                                 topicParam(u, "odom", "odom"));
+              },
+              {"cmd_vel", "odom"});
+    r.addRange(
+        "ros",
+        [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::RangeSensor> {
+          ctx.clock = clock();
+          const std::string kind = u.param("kind", u.authority.empty() ? "laser" : u.authority);
+          if (kind == "laser") return std::make_unique<RosLaser>(topicParam(u, "topic", "scan"));
+          if (kind == "sonar") return std::make_unique<RosSonar>(topicParam(u, "topic", "sonar"));
+          throw InputError(u.text + ": unknown range sensor kind '" + kind + "' (laser or sonar)");
+        },
+        {"kind", "topic"});
   });
 }
 

@@ -33,3 +33,41 @@ if(EXISTS /nonexistent-sketchnav)
   message(FATAL_ERROR "sim map -o created /nonexistent-sketchnav")
 endif()
 expect(2 "sketchnav train: -o '/dev/full': is a character device" train --landmarks ${WORK} -o /dev/full)
+# Image inputs (issue 28): special files refused before opening (a FIFO hung `propose`), a
+# header declaring 30000 x 30000 pixels refused before decoding (it decoded in 11 s and 5.4 GB),
+# a truncated JPEG refused (it was accepted with a grey bottom), a text file named.
+set(FX ${CMAKE_CURRENT_LIST_DIR}/fixtures)
+execute_process(COMMAND mkfifo ${WORK}/fifo.jpg RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "mkfifo failed: ${rc}")
+endif()
+expect(2 "sketchnav propose: image '${WORK}/fifo.jpg': is a FIFO, expected a regular file"
+       propose ${WORK}/fifo.jpg -o ${WORK}/p.png)
+expect(2 "sketchnav propose: image '${WORK}': is a directory, expected a regular file"
+       propose ${WORK} -o ${WORK}/p.png)
+expect(2 "sketchnav propose: image '${FX}/bomb_30000x30000.jpg': JPEG header declares 30000 x 30000 pixels \\(900000000 > 67108864\\)"
+       propose ${FX}/bomb_30000x30000.jpg -o ${WORK}/p.png)
+expect(2 "sketchnav propose: image '${FX}/truncated.jpg': truncated JPEG \\(no end-of-image marker\\)"
+       propose ${FX}/truncated.jpg -o ${WORK}/p.png)
+file(WRITE ${WORK}/notes.png "not an image\n")
+expect(2 "sketchnav propose: image '${WORK}/notes.png': not an image \\(expected JPEG, PNG"
+       propose ${WORK}/notes.png -o ${WORK}/p.png)
+if(EXISTS ${WORK}/p.png)
+  message(FATAL_ERROR "propose wrote ${WORK}/p.png for a bad image")
+endif()
+# The folder camera skips a bomb frame and a truncated one with a warning naming why.
+file(COPY ${FX}/tiny.png ${FX}/bomb_30000x30000.jpg ${FX}/truncated.jpg DESTINATION ${WORK}/bombs)
+run_ok(out err --json probe folder://${WORK}/bombs --frames 5)
+string(JSON received GET "${out}" received)
+string(JSON dropped GET "${out}" dropped)
+if(NOT received EQUAL 1 OR NOT dropped EQUAL 2)
+  message(FATAL_ERROR "probe of a folder with a bomb and a truncated frame: ${out}")
+endif()
+if(NOT err MATCHES "skipped unreadable frame.*declares 30000 x 30000")
+  message(FATAL_ERROR "no warning naming the bomb frame: ${err}")
+endif()
+# Unknown device URI parameters are errors like unknown settings (issue 28).
+expect(2 "camera URI 'folder:///x\\?fsp=10': unknown parameter 'fsp' \\(did you mean 'fps'\\?\\)"
+       probe folder:///x?fsp=10)
+expect(2 "camera URI 'sim://lab\\?sed=3': unknown parameter 'sed' \\(did you mean 'seed'\\?\\)"
+       probe sim://lab?sed=3)

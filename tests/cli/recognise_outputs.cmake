@@ -81,3 +81,32 @@ expect(2 "--annotate is for IMAGE" recognise --model ${WORK}/demo.slm --eval ${W
 run_ok(out err --json recognise --model ${WORK}/demo.slm --frame 640x480
        ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_1x4000.png
        ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_4000x1.png)
+# Image inputs (issue 28): one bad IMAGE is exit 2 naming it (a FIFO blocked for ever, a header
+# declaring 30000 x 30000 pixels decoded to gigabytes); among several it is skipped with a
+# warning that says why and the others are answered.
+set(FX ${CMAKE_CURRENT_LIST_DIR}/fixtures)
+execute_process(COMMAND mkfifo ${WORK}/fifo.jpg RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "mkfifo failed: ${rc}")
+endif()
+expect(2 "sketchnav recognise: image '${WORK}/fifo.jpg': is a FIFO, expected a regular file"
+       recognise --model ${WORK}/demo.slm ${WORK}/fifo.jpg)
+expect(2 "sketchnav recognise: image '${FX}/bomb_30000x30000.jpg': JPEG header declares 30000 x 30000 pixels"
+       recognise --model ${WORK}/demo.slm ${FX}/bomb_30000x30000.jpg)
+expect(2 "sketchnav recognise: image '${FX}/truncated.jpg': truncated JPEG"
+       recognise --model ${WORK}/demo.slm ${FX}/truncated.jpg)
+# (exit 1: some images were not answered)
+execute_process(COMMAND ${SN} --json recognise --model ${WORK}/demo.slm ${FX}/bomb_30000x30000.jpg
+                        ${WORK}/fifo.jpg ${WORK}/eval/Oatly-Oat-Milk/Oatly-Oat-Milk_001.jpg
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err TIMEOUT 120)
+if(NOT rc EQUAL 1)
+  message(FATAL_ERROR "recognise with 2 bad images of 3: exit ${rc}, expected 1\n${err}")
+endif()
+if(NOT err MATCHES "skipping unreadable image.*declares 30000 x 30000" OR NOT err MATCHES "is a FIFO")
+  message(FATAL_ERROR "recognise: no warnings naming the bad images:\n${err}")
+endif()
+string(JSON n LENGTH "${out}" results)
+string(JSON unreadable GET "${out}" unreadable)
+if(NOT n EQUAL 1 OR NOT unreadable EQUAL 2)
+  message(FATAL_ERROR "recognise: ${n} answers (1), ${unreadable} unreadable (2):\n${out}")
+endif()

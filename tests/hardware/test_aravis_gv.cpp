@@ -144,7 +144,13 @@ TEST(AravisGv, LinkCallbackReportsLostThenBackInOrder) {
   p.width = 64;
   p.height = 48;
   p.fps = 30;
-  p.lost_timeout_s = 0.5;
+  // By contract a (re)opened camera that sends no frame for lost_timeout_s is lost again and
+  // reopened, so reconnects() == 1 below needs the restarted fake camera to deliver its first
+  // frame within lost_timeout_s of being reopened. At 0.5 s a loaded machine (load ~15 on 2
+  // cores) starved it that long twice and reconnects() read 3 (the link callback still said
+  // lost, back: it reports transitions only). 2 s gives the restart 4x that margin; loss is
+  // still detected within the loop's 8 s.
+  p.lost_timeout_s = 2.0;
   p.reconnect_period_s = 0.2;
   AravisCamera cam("127.0.0.1", p, nullptr);
   std::mutex m;

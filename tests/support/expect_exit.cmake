@@ -1,7 +1,9 @@
 # expect(CODE PATTERN ARGS...): runs ${SN} ARGS and fails the calling test script unless it
 # exits with CODE and its output matches PATTERN. Shared by the command-line test scripts.
 function(expect code pattern)
-  execute_process(COMMAND ${SN} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+  # A bad input must not hang the command (a FIFO given as an input once did): 120 s at most.
+  execute_process(COMMAND ${SN} ${ARGN} RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err
+                  TIMEOUT 120)
   if(NOT rc EQUAL ${code})
     message(FATAL_ERROR "sketchnav ${ARGN}: exit ${rc}, expected ${code}\n${out}\n${err}")
   endif()

@@ -91,18 +91,26 @@ void registerDrivers() {
   static std::once_flag once;
   std::call_once(once, [] {
     auto& r = hw::Registry::instance();
-    r.addCamera("sim", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
-      return std::make_unique<CameraHandle>(simulatorFor(u.text, ctx), u.text);
-    });
-    r.addBase("sim", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
-      return std::make_unique<BaseHandle>(simulatorFor(u.text, ctx), u.text);
-    });
-    r.addRange("sim", [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::RangeSensor> {
-      const std::string sensor = u.param("sensor", "laser");
-      if (sensor != "laser" && sensor != "sonar")
-        throw InputError("'" + u.text + "': sensor must be laser or sonar, got '" + sensor + "'");
-      return std::make_unique<RangeHandle>(simulatorFor(u.text, ctx), sensor == "laser", u.text);
-    });
+    r.addCamera("sim",
+                [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
+                  return std::make_unique<CameraHandle>(simulatorFor(u.text, ctx), u.text);
+                },
+                {"seed", "realtime"});
+    r.addBase("sim",
+              [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
+                return std::make_unique<BaseHandle>(simulatorFor(u.text, ctx), u.text);
+              },
+              {"seed", "realtime"});
+    r.addRange("sim",
+               [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::RangeSensor> {
+                 const std::string sensor = u.param("sensor", "laser");
+                 if (sensor != "laser" && sensor != "sonar")
+                   throw InputError("'" + u.text + "': sensor must be laser or sonar, got '" +
+                                    sensor + "'");
+                 return std::make_unique<RangeHandle>(simulatorFor(u.text, ctx), sensor == "laser",
+                                                      u.text);
+               },
+               {"sensor", "seed", "realtime"});
   });
 }
 

@@ -777,6 +777,31 @@ TEST(TimeModel, DevicesIntegrateLazilyToTheClock) {
 }
 
 // ---------------------------------------------------------------- registry and map
+// Issue 28: sim://lab?sed=3 ran with the default seed; now it names the parameter.
+TEST(Registry, UnknownSimUriParameterIsRefusedWithTheClosestKnownOne) {
+  sim::registerDrivers();
+  hw::DeviceContext ctx;
+  auto message = [&](auto create) -> std::string {
+    try {
+      create();
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "";
+  };
+  auto& r = hw::Registry::instance();
+  EXPECT_EQ(message([&] { r.createCamera("sim://corridor?sed=3", ctx); }),
+            "camera URI 'sim://corridor?sed=3': unknown parameter 'sed' (did you mean 'seed'?)");
+  EXPECT_EQ(message([&] { r.createBase("sim://corridor?seed=3&realtim=1", ctx); }),
+            "base URI 'sim://corridor?seed=3&realtim=1': unknown parameter 'realtim' (did you "
+            "mean 'realtime'?)");
+  EXPECT_EQ(message([&] { r.createRange("sim://corridor?sensr=sonar", ctx); }),
+            "range sensor URI 'sim://corridor?sensr=sonar': unknown parameter 'sensr' (did you "
+            "mean 'sensor'?)");
+  // None of them created the simulator.
+  EXPECT_EQ(ctx.shared.count("sim:corridor"), 0u);
+}
+
 TEST(Registry, SimUrisShareOneSimulatorAndItsClock) {
   sim::registerDrivers();
   hw::DeviceContext ctx;

@@ -35,11 +35,21 @@ class Registry {
 
   static Registry& instance();
 
-  void addCamera(const std::string& scheme, CameraFactory f);
-  void addBase(const std::string& scheme, BaseFactory f);
-  void addRange(const std::string& scheme, RangeFactory f);
+  /// The query parameters a scheme's URIs may carry (e.g. {"fps", "loop", "hfov_deg"} for
+  /// folder://); any other is refused before the factory runs, like an unknown setting.
+  /// kAnyParameter in the list lets every other key through (laser://, whose query is the
+  /// driver's own configuration).
+  using Parameters = std::vector<std::string>;
+  static constexpr const char* kAnyParameter = "*";
 
-  /// Throw InputError naming the URI and the known schemes when the scheme is unknown.
+  void addCamera(const std::string& scheme, CameraFactory f, Parameters params = {});
+  void addBase(const std::string& scheme, BaseFactory f, Parameters params = {});
+  void addRange(const std::string& scheme, RangeFactory f, Parameters params = {});
+
+  /// Throw InputError naming the URI and the known schemes when the scheme is unknown, and
+  /// naming the parameter and the closest known one when the query holds a parameter the
+  /// scheme does not take: "camera URI 'folder:///x?fsp=10': unknown parameter 'fsp' (did
+  /// you mean 'fps'?)".
   std::unique_ptr<Camera> createCamera(const std::string& uri, DeviceContext& ctx) const;
   std::unique_ptr<Base> createBase(const std::string& uri, DeviceContext& ctx) const;
   std::unique_ptr<RangeSensor> createRange(const std::string& uri, DeviceContext& ctx) const;
@@ -50,10 +60,20 @@ class Registry {
 
  private:
   mutable std::mutex mutex_;
-  std::map<std::string, CameraFactory> cameras_;
-  std::map<std::string, BaseFactory> bases_;
-  std::map<std::string, RangeFactory> ranges_;
+  template <class F>
+  struct Entry {
+    F factory;
+    Parameters params;
+  };
+  std::map<std::string, Entry<CameraFactory>> cameras_;
+  std::map<std::string, Entry<BaseFactory>> bases_;
+  std::map<std::string, Entry<RangeFactory>> ranges_;
 };
+
+/// Throws InputError "<kind> URI '<uri>': unknown parameter 'k' (did you mean 'known'?)" for
+/// the first query key not in `known` (see Registry::Parameters).
+void requireKnownParameters(const Uri& uri, const std::string& kind,
+                            const Registry::Parameters& known);
 
 /// Registers folder:// and video:// cameras (and, as they land, the hardware drivers).
 /// Idempotent.
