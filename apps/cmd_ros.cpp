@@ -157,7 +157,8 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     o.config = c;
     o.out_dir = args.get("out").empty() ? "" : makeOutputDir(args.get("out"));
     o.progress = true;
-    o.on_event = [&](const Json& e) {
+    o.on_event = [&](const nav::NavEvent& ev) {
+      const Json e = ev.toJson();
       // The route starts: one command, so a simulator holding its time at 0 starts too.
       if (e.value("type", "") == "start") ros::sendZeroCommand();
       events.publish(e);
