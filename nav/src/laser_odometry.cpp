@@ -5,6 +5,8 @@
 #include <mrpt/poses/CPosePDF.h>
 #include <mrpt/slam/CICP.h>
 
+#include <Eigen/Eigenvalues>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 
@@ -30,6 +32,8 @@ void LaserOdometryParams::validate() const {
   require(max_correction_deg > 0, "nav.laser_odometry.max_correction_deg", "must be > 0");
   require(match_dist_m > 0, "nav.laser_odometry.match_dist_m", "must be > 0");
   require(match_deg >= 0, "nav.laser_odometry.match_deg", "must be >= 0");
+  require(constrained_points >= 0, "nav.laser_odometry.constrained_points", "must be >= 0");
+  require(normal_radius_m > 0, "nav.laser_odometry.normal_radius_m", "must be > 0");
 }
 
 namespace {
@@ -38,6 +42,40 @@ CPose2D toMrpt(const hw::Pose2D& p) {
 }
 hw::Pose2D fromMrpt(const CPose2D& p) {
   return {p.x(), p.y(), p.phi()};
+}
+
+// How well the scan's surfaces pin a translation down, direction by direction: the sum over
+// the points of n n^T, n the unit normal of the surface through the point (a line fitted to
+// its beam neighbours within `radius` m). It is the translation block of the point-to-line
+// alignment's Hessian: along a unit direction e, e^T H e counts the points whose surface
+// faces e (cos^2 weighted). Two parallel walls leave it near zero along them. Points with no
+// line through them (too few neighbours, a corner, clutter) add nothing.
+Eigen::Matrix2d surfaceInformation(const mrpt::aligned_std_vector<float>& xs,
+                                   const mrpt::aligned_std_vector<float>& ys, double radius) {
+  Eigen::Matrix2d H = Eigen::Matrix2d::Zero();
+  const int n = static_cast<int>(xs.size());
+  const int window = 10;  // beam neighbours looked at on each side
+  const double r2 = radius * radius;
+  for (int i = 0; i < n; ++i) {
+    double sx = 0, sy = 0, sxx = 0, syy = 0, sxy = 0;
+    int m = 0;
+    for (int j = std::max(0, i - window); j <= std::min(n - 1, i + window); ++j) {
+      const double dx = xs[j] - xs[i], dy = ys[j] - ys[i];
+      if (dx * dx + dy * dy > r2) continue;
+      sx += dx, sy += dy, sxx += dx * dx, syy += dy * dy, sxy += dx * dy;
+      ++m;
+    }
+    if (m < 5) continue;
+    const double mx = sx / m, my = sy / m;
+    Eigen::Matrix2d C;
+    C << sxx / m - mx * mx, sxy / m - mx * my, sxy / m - mx * my, syy / m - my * my;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(C);
+    // A line: the spread across it well under the spread along it (std. dev. ratio < 0.3).
+    if (es.eigenvalues()(0) > 0.09 * es.eigenvalues()(1)) continue;
+    const Eigen::Vector2d nrm = es.eigenvectors().col(0);
+    H += nrm * nrm.transpose();
+  }
+  return H;
 }
 }  // namespace
 
@@ -203,7 +241,33 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   const auto pdf = I.icp.Align(&I.kf_map, &cur, guess, info);
   I.ms_sum +=
       std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-  const CPose2D est = pdf->getMeanVal();
+  CPose2D est = pdf->getMeanVal();
+  // Along a direction the scan's surfaces do not pin down (a corridor's axis between two
+  // plain walls), ICP's translation is whatever its point pairs happen to settle on: it stalls
+  // or slides. There the wheels' increment is kept (the guess's component), and ICP's only
+  // across it and in heading; in between the two are blended by how constrained it is.
+  bool degenerate = false;
+  if (params_.constrained_points > 0) {
+    const Eigen::Matrix2d Hr = surfaceInformation(
+        cur.getPointsBufferRef_x(), cur.getPointsBufferRef_y(), params_.normal_radius_m);
+    const double c = std::cos(est.phi()), sn = std::sin(est.phi());
+    Eigen::Matrix2d R;
+    R << c, -sn, sn, c;
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> es(R * Hr * R.transpose());
+    Eigen::Vector2d t(est.x(), est.y());
+    const Eigen::Vector2d to_guess = Eigen::Vector2d(guess.x(), guess.y()) - t;
+    for (int k = 0; k < 2; ++k) {
+      const double lam = es.eigenvalues()(k);
+      // Share of ICP's translation kept along this direction: 0 below constrained_points, 1
+      // from twice that.
+      const double keep = std::clamp(lam / params_.constrained_points - 1.0, 0.0, 1.0);
+      if (keep >= 1.0) continue;
+      degenerate = true;
+      const Eigen::Vector2d e = es.eigenvectors().col(k);
+      t += (1.0 - keep) * e * e.dot(to_guess);
+    }
+    est = CPose2D(t.x(), t.y(), est.phi());
+  }
   const CPose2D diff = est - guess;
   // How much of the scan the reference explains at the result: the share of its points with a
   // reference point within match_dist_m + match_deg * range. Not ICP's own goodness, which is
@@ -230,6 +294,7 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   CPose2D now_pose = predicted;
   if (ok) {
     ++stats_.aligned;
+    if (degenerate) ++stats_.degenerate;
     now_pose = I.kf_pose + est;
     I.anchor_wheel = wheel_s;
     I.anchor_pose = now_pose;

@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 #include <random>
 
 #include "sketchnav/core/error.h"
@@ -76,7 +77,7 @@ struct Result {
 // 0.6 rad/s) for `seconds`; the wheel odometry turns `drift` rad per metre too much (a
 // wheel-radius mismatch). Errors are at the end.
 Result drive(double drift, double seconds, bool with_laser, unsigned seed,
-             LaserOdometryParams p = {}) {
+             LaserOdometryParams p = {}, double wheel_scale = 1.0) {
   std::mt19937 rng(seed);
   const auto segs = room();
   LaserOdometry lo(p);
@@ -100,7 +101,7 @@ Result drive(double drift, double seconds, bool with_laser, unsigned seed,
       if (leg >= len - 1e-9) turning = true, ++legs;
     }
     advance(truth, ds, dth);
-    advance(wheel, ds, dth + drift * ds);
+    advance(wheel, wheel_scale * ds, dth + drift * ds);
     lo.wheel(wheel, t);
     if (with_laser && k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
   }
@@ -125,6 +126,19 @@ TEST(LaserOdometry, TakesOutWheelHeadingDrift) {
   EXPECT_LT(r.fixed_pos_err, 0.3);
   EXPECT_GT(r.stats.aligned, r.stats.scans * 8 / 10);
   EXPECT_GT(r.stats.keyframes, 20);
+}
+
+// A wheel-radius error (the wheels count 6 % too far) is corrected in a furnished room: its
+// walls and furniture face every direction, so no axis is left to the wheels.
+TEST(LaserOdometry, TakesOutWheelScaleErrorInAFurnishedRoom) {
+  const Result r = drive(0.0, 100, true, 8, {}, 1.06);  // 1.5 loops, ending mid-leg
+  std::printf("room, wheels 6 %% long: wheels %.2f m off, fused %.2f m\n", r.raw_pos_err,
+              r.fixed_pos_err);
+  EXPECT_GT(r.raw_pos_err, 0.3);    // the wheels alone (0.38 m)...
+  EXPECT_LT(r.fixed_pos_err, 0.1);  // ...scan matching (0.01 m)
+  EXPECT_LT(r.fixed_heading_err, 0.03);
+  EXPECT_GT(r.stats.aligned, r.stats.scans * 8 / 10);
+  EXPECT_LT(r.stats.degenerate, r.stats.aligned / 10);
 }
 
 TEST(LaserOdometry, WithoutScansItIsTheWheelOdometry) {
@@ -290,5 +304,67 @@ TEST(LaserOdometry, RenewsTheKeyframeWhenTheViewMovesOn) {
     EXPECT_GT(r.raw_heading_err, 0.08) << seed;    // the wheels: 5.4 degrees off
     EXPECT_LT(r.fixed_heading_err, 0.02) << seed;  // (0.5 at most)
     EXPECT_GT(r.stats.aligned, r.stats.scans * 95 / 100) << seed;
+  }
+}
+
+namespace {
+// 20 m along a plain 2.2 m wide corridor (two parallel walls, the ends beyond the laser's
+// 8 m), wheels counting `wheel_scale` of the distance and drifting 0.01 rad/m in heading.
+// The along-axis error is the final |x| error; the wheels' own is that of their path length.
+struct CorridorResult {
+  double along_err = 0, across_err = 0, heading_err = 0, wheel_along_err = 0;
+  LaserOdometryStats stats;
+};
+CorridorResult corridor(unsigned seed, double wheel_scale, LaserOdometryParams p = {}) {
+  std::mt19937 rng(seed);
+  const std::vector<Seg> segs{{-15, 0, 45, 0}, {-15, 2.2, 45, 2.2}};
+  LaserOdometry lo(p);
+  const hw::Pose2D start{0, 1.1, 0};
+  hw::Pose2D truth = start, wheel{0, 0, 0};
+  const double dt = 0.05, v = 0.4;
+  double wheel_path = 0;
+  for (int k = 0; truth.x < 20.0; ++k) {
+    const double t = k * dt;
+    // A gentle weave round the centre line, as a robot following it does.
+    const double w = 0.1 * std::sin(0.4 * t) - 0.5 * (truth.y - 1.1) - 0.5 * truth.theta;
+    const double ds = v * dt, dth = w * dt;
+    advance(truth, ds, dth);
+    advance(wheel, wheel_scale * ds, dth + 0.01 * ds);
+    wheel_path += wheel_scale * ds;
+    lo.wheel(wheel, t);
+    if (k % 2 == 0) lo.scan(scanAt(truth, segs, t, rng));
+  }
+  CorridorResult r;
+  const auto f = lo.pose();
+  r.along_err = std::abs(f.x - (truth.x - start.x));
+  r.across_err = std::abs(f.y - (truth.y - start.y));
+  r.heading_err = std::abs(wrapAngle(f.theta - truth.theta));
+  r.wheel_along_err = std::abs(wheel_path - wheel_path / wheel_scale);
+  r.stats = lo.stats();
+  return r;
+}
+}  // namespace
+
+// Between two plain walls a scan pins down the distance to them and the heading, not the
+// position along them: ICP's translation along the corridor is what its point pairs settle
+// on. The fused estimate must take the wheels' increment there (error within theirs) while
+// keeping ICP's heading and across-axis corrections (the wheels drift 0.2 rad here); ICP
+// trusted along the axis, as before, ends metres off.
+TEST(LaserOdometry, DoesNotDriftAlongAFeaturelessCorridor) {
+  for (unsigned seed : {1u, 2u, 3u}) {
+    for (double scale : {0.97, 1.03}) {
+      const CorridorResult r = corridor(seed, scale);
+      EXPECT_LT(r.along_err, r.wheel_along_err + 0.1) << seed << " " << scale;
+      EXPECT_LT(r.across_err, 0.1) << seed << " " << scale;
+      EXPECT_LT(r.heading_err, 0.02) << seed << " " << scale;
+      EXPECT_GT(r.stats.aligned, r.stats.scans * 8 / 10) << seed << " " << scale;
+      EXPECT_GT(r.stats.degenerate, r.stats.aligned * 8 / 10) << seed << " " << scale;
+      LaserOdometryParams icp_only;
+      icp_only.constrained_points = 0;
+      const CorridorResult b = corridor(seed, scale, icp_only);
+      EXPECT_GT(b.along_err, 2 * r.along_err + 0.3) << seed << " " << scale;
+      std::printf("seed %u scale %.2f: along %.2f m (wheels %.2f, ICP only %.2f)\n", seed, scale,
+                  r.along_err, r.wheel_along_err, b.along_err);
+    }
   }
 }
