@@ -1,7 +1,8 @@
 // The executive in closed loop on fake devices (a unicycle on a SimClock, a laser over
 // discs, a geometric test-only perception): reaches the end with landmarks, without one,
-// fails "lost" when landmarks keep missing, avoids a disc on the path, and stops within
-// 200 ms on a dropped camera, a lost link or an exception.
+// fails "lost" when landmarks keep missing, avoids a disc on the path, turns to look for a
+// landmark the sketch puts to the side (within its budget), and stops within 200 ms on a
+// dropped camera, a lost link or an exception.
 #include <gtest/gtest.h>
 
 #include <cmath>
