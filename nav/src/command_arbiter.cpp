@@ -12,6 +12,8 @@ const char* toString(Behaviour b) {
       return "recover";
     case Behaviour::Dock:
       return "dock";
+    case Behaviour::SideLook:
+      return "side_look";
     case Behaviour::Detour:
       return "detour";
     case Behaviour::Avoid:
@@ -29,6 +31,7 @@ const char* toString(Behaviour b) {
 Mode modeOf(Behaviour b) {
   switch (b) {
     case Behaviour::FinalLook:
+    case Behaviour::SideLook:
     case Behaviour::Look:
       return Mode::Look;
     case Behaviour::Yield:
@@ -49,12 +52,12 @@ Mode modeOf(Behaviour b) {
   return Mode::Follow;
 }
 
-const std::array<Behaviour, 9>& CommandArbiter::priority() {
+const std::array<Behaviour, 10>& CommandArbiter::priority() {
   // The enum is declared in this order; the list says it where it is used.
-  static const std::array<Behaviour, 9> p = {
-      Behaviour::FinalLook, Behaviour::Yield,  Behaviour::Recover,
-      Behaviour::Dock,      Behaviour::Detour, Behaviour::Avoid,
-      Behaviour::Servo,     Behaviour::Look,   Behaviour::Follow};
+  static const std::array<Behaviour, 10> p = {
+      Behaviour::FinalLook, Behaviour::Yield,  Behaviour::Recover, Behaviour::Dock,
+      Behaviour::SideLook,  Behaviour::Detour, Behaviour::Avoid,   Behaviour::Servo,
+      Behaviour::Look,      Behaviour::Follow};
   return p;
 }
 

@@ -219,6 +219,19 @@ struct Writer {
     j["seen"] = e.seen;
     return "final_look_end";
   }
+  const char* operator()(const event::SideLookStart& e) {
+    j["id"] = e.id;
+    j["section"] = e.section;
+    j["bearing_deg"] = e.bearing_deg;
+    j["range_m"] = e.range_m;
+    return "side_look_start";
+  }
+  const char* operator()(const event::SideLookEnd& e) {
+    j["id"] = e.id;
+    j["seen"] = e.seen;
+    j["duration_s"] = e.duration_s;
+    return "side_look_end";
+  }
 };
 
 }  // namespace

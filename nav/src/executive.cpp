@@ -65,6 +65,14 @@ void ExecutiveParams::validate() const {
           "must be in (0, 180]");
   require(look_bearing_deg > 0 && look_bearing_deg <= 90, "nav.look_bearing_deg",
           "must be in (0, 90]");
+  require(side_look_s >= 0, "nav.side_look_s", "must be >= 0 (0 = off)");
+  require(side_look_range_m > 0, "nav.side_look_range_m", "must be > 0");
+  require(side_look_min_range_m >= 0 && side_look_min_range_m < side_look_range_m,
+          "nav.side_look_min_range_m", "must be in [0, nav.side_look_range_m)");
+  require(side_look_margin_deg >= 0 && side_look_margin_deg < 90, "nav.side_look_margin_deg",
+          "must be in [0, 90)");
+  require(side_look_max_bearing_deg > 0 && side_look_max_bearing_deg <= 180,
+          "nav.side_look_max_bearing_deg", "must be in (0, 180]");
 }
 
 NavSettings navSettingsFrom(const Config& c) {
@@ -158,6 +166,7 @@ struct LmTrack {
   Eigen::Vector2d last_origin{0, 0};
   double last_world_bearing = 0, last_point_range = 0;
   std::vector<Sighting> sightings;  // within fix range, for locateLandmark()
+  bool side_looked = false;         // a look to the side was spent on it (once per landmark)
 };
 }  // namespace
 
@@ -220,6 +229,11 @@ struct Executive::Impl {
   bool fl_was_missed = false;
   bool fl_done = false;
   bool final_looking = false;  // this tick
+  // Look to the side (ExecutiveParams::side_look_s): for which landmark, since when.
+  bool side_looking = false;
+  int sl_k = -1, sl_i = -1;
+  double sl_t = 0;
+  double half_fov = 0;  // [rad] the camera's half horizontal field of view
   int detours = 0;
   SettleChecker settle_checker;
   Eigen::Vector2d fix_route{0, 0}, fix_odom{0, 0};       // last trusted fix (start, then landmarks)
@@ -260,6 +274,7 @@ struct Executive::Impl {
     scans.resize(dev.ranges.size());
     scan_stamps.assign(dev.ranges.size(), -1e300);
     if (dev.camera) K = dev.camera->intrinsics();
+    if (dev.camera) half_fov = std::atan2(0.5 * K.width, K.fx);
     for (const auto& sec : tracker.route().sections) tracks.emplace_back(sec.landmarks.size());
   }
 
@@ -820,6 +835,7 @@ struct Executive::Impl {
         arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
       }
     }
+    sideLook(att.empty() ? nullptr : &att[0], docking || recovering, dodging && moving_seen, arb);
     // An end point that cannot be reached (the sketch put it in or against an obstacle): when
     // the robot is dodging within end_blocked_m of it, the section is done.
     bool end_blocked = false;
@@ -926,6 +942,47 @@ struct Executive::Impl {
       row.landmark = lm ? lm->id : "";
       row.front_free_m = front;
       obs->onTick(row);
+    }
+  }
+
+  // Looking to the side (ExecutiveParams::side_look_s): starts when the attended landmark `a`
+  // (never seen, no look spent on it) is predicted outside the camera's view and within
+  // range; ends when it is seen, is no longer the attended one, or the budget is spent.
+  // While it lasts it proposes a turn on the spot towards it, except while the robot is
+  // busy elsewhere (`busy`: docking or recovering, no look starts) or dodging something that
+  // comes towards it (`give_way`: the dodge drives; the clock still runs).
+  template <class A>
+  void sideLook(const A* a, bool busy, bool give_way, CommandArbiter& arb) {
+    const auto& p = s.exec;
+    const double max_b = p.side_look_max_bearing_deg * M_PI / 180;
+    if (side_looking) {
+      const LmTrack& t = tracks[sl_k][sl_i];
+      const bool same = a && a->k == sl_k && a->i == sl_i;
+      const bool seen = t.frames_seen > 0;
+      if (seen || !same || final_looking || now - sl_t > p.side_look_s ||
+          std::abs(a->pred.bearing) > max_b) {
+        side_looking = false;
+        event(event::SideLookEnd{tracker.route().sections[sl_k].landmarks[sl_i].id, seen,
+                                 now - sl_t});
+        // Standing still to look is not being stuck.
+        progress_checker.reset(pose, now);
+      }
+    } else if (a && dev.camera && p.side_look_s > 0 && !busy && !final_looking &&
+               a->tr->state == LmState::Pending && a->tr->frames_seen == 0 && !a->tr->side_looked) {
+      const double b = std::abs(a->pred.bearing);
+      if (b > half_fov - p.side_look_margin_deg * M_PI / 180 && b <= max_b &&
+          a->pred.range <= p.side_look_range_m && a->pred.range >= p.side_look_min_range_m) {
+        side_looking = true;
+        sl_k = a->k;
+        sl_i = a->i;
+        sl_t = now;
+        a->tr->side_looked = true;
+        event(event::SideLookStart{a->lm->id, a->k, a->pred.bearing * 180 / M_PI, a->pred.range});
+      }
+    }
+    if (side_looking && !give_way) {
+      const double w = std::clamp(p.k_heading * a->pred.bearing, -p.max_w, p.max_w);
+      arb.propose(Behaviour::SideLook, {0.0, w, turnOf(w)});
     }
   }
 

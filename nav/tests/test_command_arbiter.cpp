@@ -9,8 +9,8 @@ using namespace sketchnav::nav;
 
 TEST(CommandArbiter, ThePriorityListIsExplicitAndComplete) {
   const auto& p = CommandArbiter::priority();
-  const std::vector<std::string> names = {"final_look", "yield", "recover", "dock",  "detour",
-                                          "avoid",      "servo", "look",    "follow"};
+  const std::vector<std::string> names = {"final_look", "yield", "recover", "dock", "side_look",
+                                          "detour",     "avoid", "servo",   "look", "follow"};
   ASSERT_EQ(p.size(), names.size());
   for (size_t i = 0; i < p.size(); ++i) EXPECT_EQ(toString(p[i]), names[i]) << i;
   EXPECT_EQ(modeOf(Behaviour::FinalLook), Mode::Look);

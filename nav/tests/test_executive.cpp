@@ -1,7 +1,8 @@
 // The executive in closed loop on fake devices (a unicycle on a SimClock, a laser over
 // discs, a geometric test-only perception): reaches the end with landmarks, without one,
-// fails "lost" when landmarks keep missing, avoids a disc on the path, and stops within
-// 200 ms on a dropped camera, a lost link or an exception.
+// fails "lost" when landmarks keep missing, avoids a disc on the path, turns to look for a
+// landmark the sketch puts to the side (within its budget), and stops within 200 ms on a
+// dropped camera, a lost link or an exception.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -245,6 +246,105 @@ TEST(Executive, TheLostRuleStillFailsARunOnTheWay) {
     if (const auto* x = e.as<event::Failed>()) EXPECT_EQ(x->code, FailureCode::Lost);
 }
 
+// Looking to the side (ExecutiveParams::side_look_*): the route starts beside landmark A,
+// which the sketch puts ~76 deg to the left, 2.1 m away: out of the camera's +-30 deg, and
+// beyond what the look ahead turns for (look_max_bearing_deg). Driving on, it would pass
+// unseen. `visible`: whether A stands where it is drawn (else it is not there to be found).
+void landmarkBesideTheStart(Scenario& s, bool visible) {
+  s.route = makeRoute({{0, 0}, {8, 0}}, {{0, "A", "cup", {0.5, 2.0}}});
+  s.world.obstacles = {{{0.6, 2.2}, 0.15}};
+  std::vector<TrueMark> marks;
+  if (visible) marks.push_back({"cup", {0.6, 2.2}});
+  s.perception = std::make_unique<GeometricPerception>(s.world, marks);
+}
+double distTo(const Scenario& s, double x, double y) {
+  return std::hypot(s.world.truth.x - x, s.world.truth.y - y);
+}
+std::vector<event::SideLookStart> sideLookStarts(const Recorder& r) {
+  std::vector<event::SideLookStart> v;
+  for (const auto& e : r.events)
+    if (const auto* x = e.as<event::SideLookStart>()) v.push_back(*x);
+  return v;
+}
+std::vector<event::SideLookEnd> sideLookEnds(const Recorder& r) {
+  std::vector<event::SideLookEnd> v;
+  for (const auto& e : r.events)
+    if (const auto* x = e.as<event::SideLookEnd>()) v.push_back(*x);
+  return v;
+}
+
+TEST(Executive, TurnsToLookForALandmarkTheSketchPutsToTheSide) {
+  Scenario s;
+  landmarkBesideTheStart(s, true);
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  const auto starts = sideLookStarts(s.rec);
+  const auto ends = sideLookEnds(s.rec);
+  ASSERT_EQ(starts.size(), 1u);
+  ASSERT_EQ(ends.size(), 1u);
+  EXPECT_EQ(starts[0].id, "A");
+  EXPECT_GE(starts[0].bearing_deg, 70);
+  EXPECT_LE(starts[0].bearing_deg, 90);
+  EXPECT_EQ(ends[0].id, "A");
+  EXPECT_TRUE(ends[0].seen);
+  EXPECT_LT(ends[0].duration_s, s.settings.exec.side_look_s);
+  ASSERT_EQ(sum.landmarks.size(), 1u);
+  EXPECT_EQ(sum.landmarks[0].state, "passed");
+  EXPECT_EQ(s.rec.count("landmark_missed"), 0);
+  EXPECT_LT(distTo(s, 8, 0), 0.6);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+
+  // Without the look the robot drives past it.
+  Scenario off;
+  landmarkBesideTheStart(off, true);
+  off.settings.exec.side_look_s = 0;
+  const auto so = off.run();
+  EXPECT_EQ(so.status, RunStatus::Succeeded) << so.reason;
+  EXPECT_EQ(off.rec.count("side_look_start"), 0);
+  ASSERT_EQ(so.landmarks.size(), 1u);
+  EXPECT_EQ(so.landmarks[0].state, "missed");
+}
+
+TEST(Executive, ASideLookEndsWithItsBudgetAndTheRobotGoesOnWithout) {
+  // A is not where the sketch puts it: the look takes side_look_s, once, and the robot then
+  // follows the route on; A is missed and the run arrives.
+  Scenario s;
+  landmarkBesideTheStart(s, false);
+  s.settings.exec.side_look_s = 3.0;
+  const auto sum = s.run();
+  EXPECT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  const auto ends = sideLookEnds(s.rec);
+  ASSERT_EQ(s.rec.count("side_look_start"), 1);  // once per landmark
+  ASSERT_EQ(ends.size(), 1u);
+  EXPECT_FALSE(ends[0].seen);
+  EXPECT_GE(ends[0].duration_s, 3.0);
+  EXPECT_LE(ends[0].duration_s, 3.0 + 2 * s.settings.exec.tick_s);
+  ASSERT_EQ(sum.landmarks.size(), 1u);
+  EXPECT_EQ(sum.landmarks[0].state, "missed");
+  EXPECT_LT(distTo(s, 8, 0), 0.6);
+}
+
+TEST(Executive, NoSideLookForALandmarkInViewOrBehindTheAngleBudget) {
+  // Ahead and a little to the side: seen before it leaves the view, no turn to look.
+  Scenario ahead;
+  ahead.route = makeRoute({{0, 0}, {8, 0}}, {{0, "A", "cup", {4.0, 0.6}}});
+  ahead.world.obstacles = {{{4.1, 0.8}, 0.15}};
+  ahead.perception = std::make_unique<GeometricPerception>(
+      ahead.world, std::vector<TrueMark>{{"cup", {4.1, 0.8}}});
+  const auto sa = ahead.run();
+  EXPECT_EQ(sa.status, RunStatus::Succeeded) << sa.reason;
+  EXPECT_EQ(ahead.rec.count("side_look_start"), 0);
+  ASSERT_EQ(sa.landmarks.size(), 1u);
+  EXPECT_EQ(sa.landmarks[0].state, "passed");
+
+  // The same landmark beside the start, with an angle budget below its bearing: no look.
+  Scenario narrow;
+  landmarkBesideTheStart(narrow, true);
+  narrow.settings.exec.side_look_max_bearing_deg = 60;
+  narrow.run();
+  EXPECT_EQ(narrow.rec.count("side_look_start"), 0);
+}
+
 TEST(GoalChecker, ReachedOnlyOnTheLastSectionWithinItsRadiusOrWhenFinished) {
   SectionTracker tr(makeRoute({{0, 0}, {6, 0}, {6, 5}}), SectionParams{});
   const GoalChecker goal(0.15);
@@ -296,6 +396,11 @@ TEST(NavEvent, WritesTheEventsJsonlFormat) {
   EXPECT_EQ(j["reanchor_m"], 0.48);
   EXPECT_EQ(j["fix_odom"].dump(), "[1.5,-0.5]");
   EXPECT_STREQ((NavEvent{0, event::YieldEnd{}}.type()), "yield_end");
+  EXPECT_EQ((NavEvent{5.0, event::SideLookStart{"L3", 2, 80.0, 2.0}}.toJson().dump()),
+            R"({"bearing_deg":80.0,"id":"L3","range_m":2.0,"section":2,"t":5.0,)"
+            R"("type":"side_look_start"})");
+  EXPECT_EQ((NavEvent{6.5, event::SideLookEnd{"L3", true, 1.5}}.toJson().dump()),
+            R"({"duration_s":1.5,"id":"L3","seen":true,"t":6.5,"type":"side_look_end"})");
 }
 
 TEST(Executive, StopsWithin200msOfADroppedCamera) {

@@ -16,6 +16,9 @@ enum class Behaviour {
   Yield,      // keeping out of a walking person's lane (it takes the command it would replace)
   Recover,    // stuck: driving clear towards the most open direction
   Dock,       // the last metres to the goal (the avoider is not run while docking)
+  SideLook,   // on the way, turning on the spot towards a landmark predicted out of view
+              // (above the dodges: it does not move the robot, and it gives way to an
+              // oncoming person's dodge, executive.cpp)
   Detour,     // a path planned round an obstacle
   Avoid,      // the reactive dodge
   Servo,      // visual servo on the tracked landmark
@@ -23,7 +26,8 @@ enum class Behaviour {
   Follow,     // following the route
 };
 const char* toString(Behaviour b);
-/// The telemetry mode a winning behaviour gives the tick (FinalLook and Look: Mode::Look).
+/// The telemetry mode a winning behaviour gives the tick (FinalLook, SideLook and Look:
+/// Mode::Look).
 Mode modeOf(Behaviour b);
 
 /// A velocity command: v [m/s] forward, w [rad/s] CCW, and the turn it stands for.
@@ -34,8 +38,8 @@ struct Command {
 
 class CommandArbiter {
  public:
-  /// Highest first: FinalLook, Yield, Recover, Dock, Detour, Avoid, Servo, Look, Follow.
-  static const std::array<Behaviour, 9>& priority();
+  /// Highest first: FinalLook, Yield, Recover, Dock, SideLook, Detour, Avoid, Servo, Look, Follow.
+  static const std::array<Behaviour, 10>& priority();
 
   /// Forget this tick's proposals.
   void clear();
@@ -53,7 +57,7 @@ class CommandArbiter {
   void setWinnerSpeed(double v);
 
  private:
-  static constexpr int kCount = 9;
+  static constexpr int kCount = 10;
   std::array<Command, kCount> cmd_{};
   std::array<bool, kCount> set_{};
   Command none_{};

@@ -26,6 +26,7 @@ namespace sketchnav::nav {
 enum class Mode {
   Follow,   // along the route (lookahead point)
   Look,     // heading held towards an expected landmark, or turning on the spot to look for one
+            // (to the side on the way, or at the goal)
   Servo,    // visual servo on a tracked landmark (servo::TurnLaw)
   Dock,     // the last metres to the goal, straight or on a short planned path
   Recover,  // stuck: driving clear towards the most open direction
@@ -173,6 +174,18 @@ struct FinalLookEnd {
   std::string id;
   bool seen = false;
 };
+/// Turning on the spot to look for the attended landmark, never seen, that the sketch puts
+/// outside the camera's view (ExecutiveParams::side_look_*).
+struct SideLookStart {
+  std::string id;
+  int section = 0;
+  double bearing_deg = 0, range_m = 0;  // where the sketch puts it when the look starts
+};
+struct SideLookEnd {
+  std::string id;
+  bool seen = false;      // recognised during the look
+  double duration_s = 0;  // [s]
+};
 
 }  // namespace event
 
@@ -182,7 +195,8 @@ using EventData =
                  event::SectionDone, event::AvoidStart, event::AvoidEnd, event::WalkerLane,
                  event::DetourStart, event::DetourEnd, event::RecoverStart, event::RecoverEnd,
                  event::GoalSettled, event::EndBlocked, event::YieldStart, event::YieldEnd,
-                 event::GoalDoor, event::FinalLookStart, event::FinalLookEnd>;
+                 event::GoalDoor, event::FinalLookStart, event::FinalLookEnd, event::SideLookStart,
+                 event::SideLookEnd>;
 
 /// One event: when [s, run clock, from start()] and what.
 struct NavEvent {

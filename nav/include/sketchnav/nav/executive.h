@@ -98,7 +98,21 @@ struct ExecutiveParams {
   double look_range_m = 5.0;         // [m]
   double look_bearing_deg = 10;      // [deg]
   double look_max_bearing_deg = 60;  // [deg]
-  double goal_stop_s = 0.5;          // [s] settle time at the goal
+  // Looking to the side: a landmark the look above cannot keep in view (the sketch puts it
+  // beyond look_max_bearing_deg, or the robot is already abreast of it, or dodging turned it
+  // away) would pass unseen. When the attended landmark has never been seen, its predicted
+  // bearing (odometry + sketch) is outside the camera's field of view minus
+  // side_look_margin_deg, and it is between side_look_min_range_m and side_look_range_m away,
+  // the robot stops and turns on the spot towards it (events side_look_start / _end) until it
+  // is recognised (the servo then takes over) or for at most side_look_s, then resumes
+  // following. Once per landmark; none beyond side_look_max_bearing_deg (a landmark behind
+  // is left to the miss test, as above). side_look_s = 0: off.
+  double side_look_s = 4.0;                // [s] time budget per landmark
+  double side_look_range_m = 4.0;          // [m] predicted range within which it is tried
+  double side_look_min_range_m = 0.5;      // [m] closer than this its bearing means little
+  double side_look_margin_deg = 5;         // [deg] inside the half field of view
+  double side_look_max_bearing_deg = 110;  // [deg] angle budget: furthest the robot turns
+  double goal_stop_s = 0.5;                // [s] settle time at the goal
   double dock_m = 1.5;  // [m] this close to the goal, with a free line to it, drive straight there
   double goal_settle_m = 1.0;  // [m] within this of the goal, not 5 cm closer for
   double goal_settle_s = 8;    // [s] this long: arrived as close as it can get
@@ -165,6 +179,11 @@ struct ExecutiveParams {
     b("look_range_m", look_range_m);
     b("look_bearing_deg", look_bearing_deg);
     b("look_max_bearing_deg", look_max_bearing_deg);
+    b("side_look_s", side_look_s);
+    b("side_look_range_m", side_look_range_m);
+    b("side_look_min_range_m", side_look_min_range_m);
+    b("side_look_margin_deg", side_look_margin_deg);
+    b("side_look_max_bearing_deg", side_look_max_bearing_deg);
     b("goal_stop_s", goal_stop_s);
     b("dock_m", dock_m);
     b("goal_settle_m", goal_settle_m);
@@ -262,8 +281,8 @@ struct ExecutiveSummary {
   int frames_processed = 0;  // frames given to perception
   double perception_ms_mean = 0, perception_ms_max = 0;
   double objectness_ms_mean = 0, features_ms_mean = 0, match_ms_mean = 0;
-  int full_passes = 0;          // processed frames on which perception's full pass ran
-  int tracked_detections = 0;   // detections the tracker supplied (PerceptionTiming::tracked)
+  int full_passes = 0;         // processed frames on which perception's full pass ran
+  int tracked_detections = 0;  // detections the tracker supplied (PerceptionTiming::tracked)
   int avoidance_manoeuvres = 0;
   int recoveries = 0;  // stuck recoveries
   int detours = 0;     // detours planned round obstacles (local_planner.h)
