@@ -112,6 +112,41 @@ struct Row {
   double ms = 0;
 };
 
+// One frame through perception and the turn law, as the robot runs them: the CSV row (timed
+// over perception), the observation and the best detection's x_t / x_d (NaN when none).
+struct FrameResult {
+  Row row;
+  nav::Observation ob;
+  double x_t = NAN, x_d = NAN;
+};
+FrameResult runFrame(nav::Perception& perception, const servo::TurnLaw& law, const cv::Mat& img,
+                     const std::string& name, long i, const hw::Intrinsics& k,
+                     const std::string& target) {
+  hw::Frame f;
+  f.image = img;
+  f.seq = static_cast<std::uint64_t>(i);
+  f.source = name;
+  FrameResult out;
+  const auto t0 = std::chrono::steady_clock::now();
+  out.ob = perception.observe(f, k, {target});
+  Row& r = out.row;
+  r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
+  r.frame = i;
+  r.name = name;
+  r.windows = out.ob.timing.windows;
+  if (!out.ob.detections.empty()) {
+    const auto& d = out.ob.detections.front();
+    r.cls = d.class_name;
+    r.inliers = d.inliers;
+    out.x_t = d.x_t, out.x_d = d.x_d;
+    const servo::TurnCommand c = law.compute(d.x_t, d.x_d);
+    r.error = c.error;
+    r.w = c.w;
+    r.turn = servo::toString(c.state);
+  }
+  return out;
+}
+
 cv::Mat thumbnail(const cv::Mat& img, const nav::Observation& ob, const Row& r,
                   const std::string& truth) {
   cv::Mat a = img.clone();
@@ -318,22 +353,9 @@ int runEval(const Args& args, GlobalOptions& g) {
     hw::Intrinsics k;
     long i = 0;
     while ((max_frames <= 0 || i < max_frames) && source.next(img, name, k)) {
-      hw::Frame f;
-      f.image = img;
-      f.seq = static_cast<std::uint64_t>(i);
-      f.source = name;
-      const auto t0 = std::chrono::steady_clock::now();
-      const nav::Observation ob = perception.observe(f, k, {seqs[s].target});
-      Row r;
-      r.ms =
-          std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-      double x_t = NAN;
-      if (!ob.detections.empty()) {
-        const auto& d = ob.detections.front();
-        r.inliers = d.inliers;
-        x_t = d.x_t;
-        r.turn = servo::toString(law.compute(d.x_t, d.x_d).state);
-      }
+      const FrameResult fr = runFrame(perception, law, img, name, i, k, seqs[s].target);
+      const Row& r = fr.row;
+      const double x_t = fr.x_t;
       ++i;
       const auto it = truths[s].find(name);
       if (it == truths[s].end()) continue;
@@ -512,29 +534,11 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   hw::Intrinsics k;
   long i = 0;
   while ((max_frames <= 0 || i < max_frames) && source.next(img, name, k)) {
-    hw::Frame f;
-    f.image = img;
-    f.seq = static_cast<std::uint64_t>(i);
-    f.source = name;
-    const auto t0 = std::chrono::steady_clock::now();
-    const nav::Observation ob = perception.observe(f, k, {target});
-    Row r;
-    r.frame = i;
-    r.name = name;
-    r.ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count();
-    r.windows = ob.timing.windows;
-    double x_t = NAN, x_d = NAN;
-    if (!ob.detections.empty()) {
-      const auto& d = ob.detections.front();
-      r.cls = d.class_name;
-      r.inliers = d.inliers;
-      x_t = d.x_t, x_d = d.x_d;
-      const servo::TurnCommand c = law.compute(d.x_t, d.x_d);
-      r.error = c.error;
-      r.w = c.w;
-      r.turn = servo::toString(c.state);
-      ++detected;
-    }
+    const FrameResult fr = runFrame(perception, law, img, name, i, k, target);
+    const nav::Observation& ob = fr.ob;
+    const Row& r = fr.row;
+    const double x_t = fr.x_t, x_d = fr.x_d;
+    if (!ob.detections.empty()) ++detected;
     std::string expected;
     bool in_truth = true;
     if (auto it = truth.find(name); it != truth.end())

@@ -64,13 +64,20 @@ PerceptionParams perceptionParamsFrom(const Config& config) {
   return p;
 }
 
-Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
-                                const std::vector<LookFor>& look_for) {
+namespace {
+// The hinted classes, each once, in hint order.
+std::vector<std::string> classesOf(const std::vector<LookFor>& look_for) {
   std::vector<std::string> classes;
   for (const auto& l : look_for)
     if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
       classes.push_back(l.class_name);
-  return observe(frame, k, classes);
+  return classes;
+}
+}  // namespace
+
+Observation Perception::observe(const hw::Frame& frame, const hw::Intrinsics& k,
+                                const std::vector<LookFor>& look_for) {
+  return observe(frame, k, classesOf(look_for));
 }
 
 struct LandmarkPerception::Impl {
@@ -416,19 +423,8 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
   }
   std::sort(ob.detections.begin(), ob.detections.end(),
             [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
-  ob.timing.fovea_ms = msSince(tf);
-  ob.timing.total_ms += ob.timing.fovea_ms;
+  ob.timing.fovea_ms = msSince(tf);  // observeFrame() sets total_ms over all of it
 }
-
-namespace {
-std::vector<std::string> classesOf(const std::vector<LookFor>& look_for) {
-  std::vector<std::string> classes;
-  for (const auto& l : look_for)
-    if (std::find(classes.begin(), classes.end(), l.class_name) == classes.end())
-      classes.push_back(l.class_name);
-  return classes;
-}
-}  // namespace
 
 Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
                                         const std::vector<std::string>& classes) {
