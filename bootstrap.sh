@@ -24,6 +24,12 @@ PACKAGES=(
   # message headers, tf2 and cv_bridge to build it, rosmaster for its tests.
   libroscpp-dev libcv-bridge-dev libtf2-ros-dev libstd-msgs-dev libsensor-msgs-dev
   libnav-msgs-dev libgeometry-msgs-dev libros-rosgraph-msgs-dev librosbag-storage-dev python3-rosmaster
+  # the route action (generated at build time: genaction + gencpp, the .msg definitions)
+  libactionlib-dev libactionlib-msgs-dev python3-genmsg python3-gencpp ros-std-msgs
+  ros-actionlib-msgs
+  # /diagnostics, the annotated image, rviz markers; roslaunch / rostopic for the tests
+  libdiagnostic-updater-dev libdiagnostic-msgs-dev libimage-transport-dev
+  libvisualization-msgs-dev libtf2-msgs-dev python3-roslaunch python3-rostopic
 )
 
 missing=()

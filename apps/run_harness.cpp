@@ -561,17 +561,18 @@ Json runNavigation(const RunOptions& o) {
   {
     nav::Perception& used = o.on_observation ? static_cast<nav::Perception&>(tapped) : perception;
     nav::Executive ex(route, dev, used, settings, &observer);
-    if (o.stop_requested) {
+    if (o.stop_requested || o.after_step) {
       // Executive::run()'s loop, asking before every tick whether the user pressed Stop.
       ex.start();
       double next = dev.clock->now();
       while (!ex.done()) {
         next += settings.exec.tick_s;
         dev.clock->sleepUntil(next);
-        if (o.stop_requested())
+        if (o.stop_requested && o.stop_requested())
           ex.stop("stopped by user");
         else
           ex.step();
+        if (o.after_step) o.after_step(ex);
       }
       es = ex.summary();
     } else {

@@ -54,6 +54,9 @@ struct RunOptions {
   /// Polled before every control tick: true -> the executive stops the base and the run ends
   /// (failed, reason "stopped by user").
   std::function<bool()> stop_requested;
+  /// Called after every control tick with the executive (`ros nav`: the route in the odometry
+  /// frame, distance left). On the run's thread; must not call non-const members.
+  std::function<void(const nav::Executive&)> after_step;
 };
 
 /// Every setting a run uses, over the defaults, validated. Device drivers' settings

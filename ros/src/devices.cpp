@@ -9,7 +9,9 @@
 #include <sensor_msgs/Range.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
+#include <tf2_msgs/TFMessage.h>
 
+#include <algorithm>
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
@@ -62,6 +64,11 @@ class RosCamera final : public hw::Camera {
  public:
   RosCamera(const std::string& topic, const std::string& info_topic) {
     auto& nh = detail::nodeHandle();
+    {
+      std::lock_guard<std::mutex> l(state().latency_mutex);
+      state().latency.frames.clear();  // seqs start again with this camera
+      state().latency.pending = false;
+    }
     sub_ = nh.subscribe(topic, 2, &RosCamera::onImage, this);
     if (!info_topic.empty()) info_sub_ = nh.subscribe(info_topic, 2, &RosCamera::onInfo, this);
     describe(*in_, "camera", sub_);
@@ -103,6 +110,11 @@ class RosCamera final : public hw::Camera {
                                   [this] { return seq_ > delivered_; });
     if (!got) return hw::GrabStatus::Timeout;
     delivered_ = seq_;
+    {
+      std::lock_guard<std::mutex> ll(state().latency_mutex);
+      auto it = state().latency.frames.find(seq_);
+      if (it != state().latency.frames.end()) it->second.grab = wallNow();
+    }
     frame.image = latest_;  // a new Mat per message: no copy needed
     frame.stamp = stamp_;
     frame.seq = seq_;
@@ -129,7 +141,12 @@ class RosCamera final : public hw::Camera {
     detail::garbage("camera on " + sub_.getTopic() + ": " + why);
   }
   void onImage(const sensor_msgs::ImageConstPtr& m) {
-    in_->wall_last = wallNow();
+    const double recv = wallNow();
+    in_->wall_last = recv;
+    // Stamp -> callback, when stamps are wall time (not under simulated time).
+    const double transport = !::ros::Time::isSimTime() && !m->header.stamp.isZero()
+                                 ? (::ros::Time::now() - m->header.stamp).toSec()
+                                 : -1;
     if (m->width == 0 || m->height == 0 || m->data.empty()) {
       bad("empty image (" + std::to_string(m->width) + "x" + std::to_string(m->height) + ", " +
           std::to_string(m->data.size()) + " bytes)");
@@ -153,6 +170,10 @@ class RosCamera final : public hw::Camera {
       stamp_ = stampOf(m->header.stamp);
       ++seq_;
       ++st_.received;
+      std::lock_guard<std::mutex> ll(state().latency_mutex);
+      auto& fr = state().latency.frames;
+      fr[seq_] = {recv, -1, transport};
+      while (fr.size() > 50) fr.erase(fr.begin());
     }
     cv_.notify_all();
   }
@@ -184,7 +205,9 @@ class RosCamera final : public hw::Camera {
 // ---------------------------------------------------------------------------------------
 class RosBase final : public hw::Base {
  public:
-  RosBase(const std::string& cmd_topic, const std::string& odom_topic) {
+  // odom_topic: nav_msgs/Odometry; or, with odom_topic empty, tf odom_frame -> base frame.
+  RosBase(const std::string& cmd_topic, const std::string& odom_topic,
+          const std::string& odom_frame) {
     auto& nh = detail::nodeHandle();
     pub_ = nh.advertise<geometry_msgs::Twist>(cmd_topic, 5);
     {
@@ -192,15 +215,23 @@ class RosBase final : public hw::Base {
       state().cmd_vel = pub_;
       state().have_cmd_vel = true;
     }
-    sub_ = nh.subscribe(odom_topic, 10, &RosBase::onOdom, this);
-    describe(*in_, "odometry", sub_);
-    uri_ = "ros://base?cmd_vel=" + pub_.getTopic() + "&odom=" + sub_.getTopic();
+    if (!odom_topic.empty()) {
+      sub_ = nh.subscribe(odom_topic, 10, &RosBase::onOdom, this);
+      describe(*in_, "odometry", sub_);
+      uri_ = "ros://base?cmd_vel=" + pub_.getTopic() + "&odom=" + sub_.getTopic();
+    } else {
+      odom_frame_ = strip(odom_frame);
+      base_frame_ = strip(state().params.base_frame);
+      sub_ = nh.subscribe("/tf", 100, &RosBase::onTf, this);
+      describe(*in_, "odometry (tf " + odom_frame_ + " -> " + base_frame_ + ")", sub_);
+      uri_ = "ros://base?cmd_vel=" + pub_.getTopic() + "&tf=" + odom_frame_;
+    }
     waitFirst(
         [this] {
           std::lock_guard<std::mutex> l(m_);
           return have_;
         },
-        "odometry", sub_.getTopic());
+        in_->what, sub_.getTopic());
     // Stamps on another clock than this node's make every input look stale (or fresh forever).
     double stamp;
     {
@@ -237,6 +268,7 @@ class RosBase final : public hw::Base {
     t.linear.x = v;
     t.angular.z = w;
     pub_.publish(t);
+    closeLatency();
     std::lock_guard<std::mutex> l(m_);
     ++st_.received;
   }
@@ -253,6 +285,22 @@ class RosBase final : public hw::Base {
     return true;
   }
   bool ok() const override { return !state().tripped; }
+
+  // The first command after perception examined a frame: that frame's latency.
+  static void closeLatency() {
+    const double now = wallNow();
+    std::lock_guard<std::mutex> l(state().latency_mutex);
+    auto& L = state().latency;
+    if (!L.pending) return;
+    L.pending = false;
+    const auto it = L.frames.find(L.pending_seq);
+    if (it == L.frames.end() || it->second.grab < 0) return;
+    const auto& f = it->second;
+    L.wait.push_back(f.grab - f.recv);
+    L.grab_to_cmd.push_back(now - f.grab);
+    if (f.transport >= 0) L.transport.push_back(f.transport);
+    L.total.push_back(now - f.recv + std::max(0.0, f.transport));
+  }
   hw::DeviceStats stats() const override {
     std::lock_guard<std::mutex> l(m_);
     return st_;
@@ -291,7 +339,75 @@ class RosBase final : public hw::Base {
     have_ = true;
   }
 
+  static std::string strip(const std::string& f) { return !f.empty() && f[0] == '/' ? f.substr(1) : f; }
+
+  // tf: the odom -> base transform of this message (direct), else through the tf buffer when
+  // the message moves the odometry frame's tree (odom -> base_footprint -> base_link).
+  void onTf(const tf2_msgs::TFMessageConstPtr& m) {
+    const geometry_msgs::TransformStamped* direct = nullptr;
+    bool touches = false;
+    for (const auto& t : m->transforms) {
+      const std::string parent = strip(t.header.frame_id), child = strip(t.child_frame_id);
+      if (parent == odom_frame_ && child == base_frame_) direct = &t;
+      if (parent == odom_frame_ || child == base_frame_) touches = true;
+    }
+    geometry_msgs::TransformStamped looked;
+    if (!direct) {
+      if (!touches || !state().tf) return;
+      try {
+        looked = state().tf->lookupTransform(odom_frame_, base_frame_, ::ros::Time(0));
+      } catch (const std::exception&) {
+        return;
+      }
+      direct = &looked;
+    }
+    const double stamp = stampOf(direct->header.stamp);
+    {
+      std::lock_guard<std::mutex> l(m_);
+      if (have_ && stamp <= odom_.stamp) return;  // an old transform again
+    }
+    in_->wall_last = wallNow();
+    const auto& p = direct->transform.translation;
+    const auto& q = direct->transform.rotation;
+    const double vals[] = {p.x, p.y, q.x, q.y, q.z, q.w};
+    bool finite = true;
+    for (double v : vals) finite = finite && std::isfinite(v);
+    const double qn = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+    if (!finite || qn < 1e-6) {
+      {
+        std::lock_guard<std::mutex> l(m_);
+        ++st_.dropped;
+        st_.last_error = finite ? "zero quaternion" : "NaN or Inf in the transform";
+      }
+      detail::garbage(in_->what + ": " +
+                      (finite ? "rotation is a zero quaternion" : "NaN or Inf in the transform"));
+      return;
+    }
+    double roll, pitch, yaw;
+    tf2::Matrix3x3(tf2::Quaternion(q.x / qn, q.y / qn, q.z / qn, q.w / qn))
+        .getRPY(roll, pitch, yaw);
+    std::lock_guard<std::mutex> l(m_);
+    // Velocities by differencing (tf carries none), over at least 20 ms.
+    if (have_ && stamp - vel_from_.stamp >= 0.02) {
+      const double dt = stamp - vel_from_.stamp;
+      const double dx = p.x - vel_from_.pose.x, dy = p.y - vel_from_.pose.y;
+      odom_.v = (dx * std::cos(yaw) + dy * std::sin(yaw)) / dt;
+      odom_.w = std::remainder(yaw - vel_from_.pose.theta, 2 * M_PI) / dt;
+      vel_from_.pose = {p.x, p.y, yaw};
+      vel_from_.stamp = stamp;
+    } else if (!have_) {
+      vel_from_.pose = {p.x, p.y, yaw};
+      vel_from_.stamp = stamp;
+    }
+    odom_.pose = {p.x, p.y, yaw};
+    odom_.stamp = stamp;
+    have_ = true;
+    ++st_.received;
+  }
+
   mutable std::mutex m_;
+  std::string odom_frame_, base_frame_;
+  hw::Odometry vel_from_;  // the tf pose velocities are differenced from
   ::ros::Publisher pub_;
   ::ros::Subscriber sub_;
   std::shared_ptr<Input> in_ = std::make_shared<Input>();  // before the subscription
@@ -525,7 +641,41 @@ std::string topicParam(const Uri& u, const std::string& key, const std::string& 
   return t;
 }
 
+double mean(const std::vector<double>& v) {
+  double s = 0;
+  for (double x : v) s += x;
+  return v.empty() ? 0 : s / v.size();
+}
+double p95(std::vector<double> v) {
+  if (v.empty()) return 0;
+  std::sort(v.begin(), v.end());
+  return v[std::min(v.size() - 1, static_cast<size_t>(0.95 * v.size()))];
+}
+
 }  // namespace
+
+void noteObservation(std::uint64_t frame_seq) {
+  std::lock_guard<std::mutex> l(state().latency_mutex);
+  state().latency.pending = true;
+  state().latency.pending_seq = frame_seq;
+}
+
+Json latencySummary() {
+  std::lock_guard<std::mutex> l(state().latency_mutex);
+  const auto& L = state().latency;
+  auto ms = [](const std::vector<double>& v) -> Json {
+    if (v.empty()) return nullptr;
+    return {{"mean_ms", mean(v) * 1000}, {"p95_ms", p95(v) * 1000}};
+  };
+  std::vector<double> over;
+  for (size_t i = 0; i < L.total.size(); ++i) over.push_back(L.total[i] - L.grab_to_cmd[i]);
+  return {{"frames", L.total.size()},
+          {"transport", ms(L.transport)},
+          {"wait", ms(L.wait)},
+          {"grab_to_cmd", ms(L.grab_to_cmd)},
+          {"total", ms(L.total)},
+          {"ros_overhead", ms(over)}};
+}
 
 void registerDrivers() {
   static std::once_flag once;
@@ -541,10 +691,15 @@ void registerDrivers() {
     r.addBase("ros",
               [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
                 ctx.clock = clock();
+                const std::string tf = u.param("tf", "");
+                if (!tf.empty() && !u.param("odom", "").empty())
+                  throw InputError(u.text + ": odometry from 'odom' (a topic) or 'tf' (a frame), "
+                                            "not both");
                 return std::make_unique<RosBase>(topicParam(u, "cmd_vel", "cmd_vel"),
-                                                 topicParam(u, "odom", "odom"));
+                                                 tf.empty() ? topicParam(u, "odom", "odom") : "",
+                                                 tf);
               },
-              {"cmd_vel", "odom"});
+              {"cmd_vel", "odom", "tf"});
     r.addRange(
         "ros",
         [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::RangeSensor> {

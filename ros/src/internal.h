@@ -6,6 +6,7 @@
 
 #include <atomic>
 #include <functional>
+#include <map>
 #include <memory>
 #include <mutex>
 #include <string>
@@ -26,6 +27,18 @@ struct Input {
   std::function<std::uint32_t()> publishers;  // number of connected publishers
 };
 
+/// Image-to-command latency samples (node.h latencySummary()).
+struct Latency {
+  struct FrameTimes {
+    double recv = -1, grab = -1;  // [s, wallNow()]
+    double transport = -1;        // [s] stamp -> callback (wall-time robots only)
+  };
+  std::map<std::uint64_t, FrameTimes> frames;  // by camera seq, the last ~50
+  bool pending = false;
+  std::uint64_t pending_seq = 0;
+  std::vector<double> transport, wait, grab_to_cmd, total;  // [s]
+};
+
 struct State {
   std::mutex mutex;
   bool initialised = false;
@@ -41,6 +54,8 @@ struct State {
   std::atomic<bool> tripped{false};
   std::thread watchdog, liveness;
   std::atomic<bool> watchdog_stop{false};
+  std::mutex latency_mutex;
+  Latency latency;
 };
 
 State& state();

@@ -268,6 +268,9 @@ void RosParams::validate() const {
   require(!odom_topic.empty(), "ros.odom_topic", "must not be empty");
   require(!cmd_vel_topic.empty(), "ros.cmd_vel_topic", "must not be empty");
   require(!base_frame.empty(), "ros.base_frame", "must not be empty");
+  require(odom_source == "topic" || odom_source == "tf", "ros.odom_source",
+          "must be 'topic' (nav_msgs/Odometry) or 'tf' (odom_frame -> base_frame)");
+  require(!odom_frame.empty(), "ros.odom_frame", "must not be empty");
 }
 
 void init(const std::string& name, const std::vector<std::string>& args, double wait_master_s) {
@@ -369,6 +372,15 @@ void trip(const std::string& reason) {
   }
   detail::publishZero();
   log::error("ros", "safety stop: " + reason + " (zero cmd_vel sent; the robot stays stopped)");
+}
+
+void resetFault() {
+  State& s = state();
+  std::lock_guard<std::mutex> l(s.mutex);
+  if (!s.tripped) return;
+  log::info("ros", "fault cleared for a new goal", {{"fault", s.fault}});
+  s.fault.clear();
+  s.tripped = false;
 }
 
 std::shared_ptr<hw::Clock> clock() {

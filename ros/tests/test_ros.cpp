@@ -2,7 +2,13 @@
 // `rosmaster --core` on a free 127.0.0.1 port, runs `sketchnav ros sim` / `sketchnav ros nav`
 // as separate processes through it, and watches cmd_vel from this process (a ROS node too).
 // Skipped when the ROS tools (rosmaster) are not installed.
+#include <actionlib/client/simple_action_client.h>
 #include <arpa/inet.h>
+#include <diagnostic_msgs/DiagnosticArray.h>
+#include <geometry_msgs/PoseStamped.h>
+#include <nav_msgs/Path.h>
+#include <sketchnav_msgs/NavigateSketchAction.h>
+#include <visualization_msgs/MarkerArray.h>
 #include <fcntl.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
@@ -19,6 +25,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -26,6 +33,7 @@
 #include <filesystem>
 #include <fstream>
 #include <limits>
+#include <map>
 #include <mutex>
 #include <sstream>
 #include <string>
@@ -35,6 +43,7 @@
 #include <rosbag/bag.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <opencv2/imgcodecs.hpp>
+#include <opencv2/imgproc.hpp>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
@@ -689,3 +698,337 @@ TEST(RosBag, CameraReadsImagesFromABag) {
 }
 
 }  // namespace
+
+// ---------------------------------------------------------------------------------------
+// The route action, its topic twins and what the node publishes for rviz / diagnostics.
+namespace {
+
+using RouteClient = actionlib::SimpleActionClient<sketchnav_msgs::NavigateSketchAction>;
+
+// Everything the node publishes besides cmd_vel, as this observer saw it.
+struct Seen {
+  std::mutex m;
+  int diagnostics = 0, poses = 0, paths = 0, markers = 0, images = 0;
+  std::string diag_keys;     // the node's status keys, "|"-joined
+  size_t path_points = 0;    // of the last ~route
+  std::string path_frame;    // its frame
+  int landmark_markers = 0;  // cylinders in the last ~landmarks
+  std::string last_result;   // ~result JSON
+};
+
+}  // namespace
+
+TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
+  const std::string sketch = shortLabSketch(dir_);
+  startSim("1");
+  if (HasFatalFailure()) return;
+  Seen seen;
+  auto diag_sub = nh_->subscribe<diagnostic_msgs::DiagnosticArray>(
+      "/diagnostics", 10, [&](const diagnostic_msgs::DiagnosticArrayConstPtr& a) {
+        std::lock_guard<std::mutex> l(seen.m);
+        for (const auto& s : a->status)
+          if (s.name.find("sketchnav navigation") != std::string::npos) {
+            ++seen.diagnostics;
+            seen.diag_keys.clear();
+            for (const auto& kv : s.values) seen.diag_keys += kv.key + "|";
+          }
+      });
+  auto pose_sub = nh_->subscribe<geometry_msgs::PoseStamped>(
+      "/sketchnav_nav/pose", 10, [&](const geometry_msgs::PoseStampedConstPtr&) {
+        std::lock_guard<std::mutex> l(seen.m);
+        ++seen.poses;
+      });
+  auto path_sub = nh_->subscribe<nav_msgs::Path>(
+      "/sketchnav_nav/route", 10, [&](const nav_msgs::PathConstPtr& p) {
+        std::lock_guard<std::mutex> l(seen.m);
+        ++seen.paths;
+        seen.path_points = p->poses.size();
+        seen.path_frame = p->header.frame_id;
+      });
+  auto mark_sub = nh_->subscribe<visualization_msgs::MarkerArray>(
+      "/sketchnav_nav/landmarks", 10, [&](const visualization_msgs::MarkerArrayConstPtr& a) {
+        std::lock_guard<std::mutex> l(seen.m);
+        ++seen.markers;
+        seen.landmark_markers = 0;
+        for (const auto& mk : a->markers)
+          if (mk.type == visualization_msgs::Marker::CYLINDER) ++seen.landmark_markers;
+      });
+  auto image_sub = nh_->subscribe<sensor_msgs::Image>(
+      "/sketchnav_nav/image", 2, [&](const sensor_msgs::ImageConstPtr& im) {
+        std::lock_guard<std::mutex> l(seen.m);
+        if (im->width > 0 && im->encoding == "bgr8") ++seen.images;
+      });
+  auto result_sub = nh_->subscribe<std_msgs::String>(
+      "/sketchnav_nav/result", 2, [&](const std_msgs::StringConstPtr& s) {
+        std::lock_guard<std::mutex> l(seen.m);
+        seen.last_result = s->data;
+      });
+  // The node without --sketch: it waits for goals.
+  nav_ = std::make_unique<Process>(
+      cmd({"ros", "nav", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR, "--max-time", "60"}),
+      (dir_ / "nav.out").string(), (dir_ / "nav.err").string());
+  RouteClient client(*nh_, "/sketchnav_nav/route", false);
+  ASSERT_TRUE(waitFor([&] { return client.isServerConnected() || !nav_->running(); }, 60))
+      << logs();
+  ASSERT_TRUE(nav_->running()) << logs();
+
+  // 1. A goal: feedback while it runs, then the result.
+  std::mutex fm;
+  std::vector<sketchnav_msgs::NavigateSketchFeedback> fb;
+  sketchnav_msgs::NavigateSketchGoal goal;
+  goal.sketch = sketch;
+  client.sendGoal(
+      goal, RouteClient::SimpleDoneCallback(), RouteClient::SimpleActiveCallback(),
+      [&](const sketchnav_msgs::NavigateSketchFeedbackConstPtr& f) {
+        std::lock_guard<std::mutex> l(fm);
+        fb.push_back(*f);
+      });
+  ASSERT_TRUE(client.waitForResult(ros::Duration(240))) << logs();
+  EXPECT_EQ(client.getState(), actionlib::SimpleClientGoalState::SUCCEEDED)
+      << client.getState().toString() << " " << client.getState().getText() << logs();
+  const auto res = client.getResult();
+  ASSERT_TRUE(res);
+  EXPECT_TRUE(res->success) << res->reason;
+  EXPECT_EQ(res->failure, "");
+  EXPECT_EQ(res->sections_done, res->sections);
+  EXPECT_GT(res->sections, 0);
+  EXPECT_TRUE(Json::parse(res->summary_json)["success"].get<bool>());
+  {
+    std::lock_guard<std::mutex> l(fm);
+    ASSERT_GT(fb.size(), 20u);
+    EXPECT_EQ(fb.front().section, 1);
+    EXPECT_EQ(fb.front().sections, res->sections);
+    // The distance left shrinks from about the route's length to about nothing.
+    EXPECT_GT(fb.front().distance_left_m, 2.0) << fb.front().distance_left_m;
+    EXPECT_LT(fb.back().distance_left_m, 0.6) << fb.back().distance_left_m;
+    std::printf("feedback: %zu messages, distance left %.2f m -> %.2f m\n", fb.size(),
+                fb.front().distance_left_m, fb.back().distance_left_m);
+  }
+  {
+    std::lock_guard<std::mutex> l(seen.m);
+    EXPECT_GT(seen.poses, 20);
+    EXPECT_GT(seen.paths, 0);
+    EXPECT_EQ(seen.path_frame, "odom");
+    EXPECT_EQ(seen.path_points, static_cast<size_t>(res->sections) + 1);
+    EXPECT_GT(seen.markers, 0);
+    EXPECT_EQ(seen.landmark_markers, 1);  // the short sketch keeps L1 only
+    EXPECT_GT(seen.images, 0);            // the annotated image (this node subscribes)
+    EXPECT_GT(seen.diagnostics, 0);
+    EXPECT_NE(seen.diag_keys.find("stopped"), std::string::npos) << seen.diag_keys;
+    EXPECT_NE(seen.diag_keys.find("age_s"), std::string::npos) << seen.diag_keys;
+  }
+
+  // 2. A second goal, cancelled while the robot drives: zero cmd_vel, nothing moves after it.
+  goal.sketch = std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json";
+  const double sent = wallNow();
+  client.sendGoal(goal);
+  auto movingSince = [&](double t) {
+    for (const auto& c : commands())
+      if (c.wall > t && std::abs(c.v) > 0.05) return true;
+    return false;
+  };
+  ASSERT_TRUE(waitFor([&] { return movingSince(sent) || !nav_->running(); }, 120)) << logs();
+  std::this_thread::sleep_for(std::chrono::milliseconds(1000));
+  const double cancelled = wallNow();
+  client.cancelGoal();
+  double stop_wall = -1;
+  ASSERT_TRUE(waitFor(
+      [&] {
+        for (const auto& c : commands())
+          if (c.wall >= cancelled && c.v == 0.0 && c.w == 0.0) {
+            stop_wall = c.wall;
+            return true;
+          }
+        return false;
+      },
+      5))
+      << "no zero cmd_vel after the cancel" << logs();
+  ASSERT_TRUE(client.waitForResult(ros::Duration(10))) << logs();
+  EXPECT_EQ(client.getState(), actionlib::SimpleClientGoalState::PREEMPTED)
+      << client.getState().toString();
+  EXPECT_EQ(client.getResult()->failure, "cancelled");
+  std::this_thread::sleep_for(std::chrono::milliseconds(700));
+  for (const auto& c : commands())
+    if (c.wall > stop_wall) EXPECT_TRUE(c.v == 0.0 && c.w == 0.0) << c.v << " " << c.w;
+  std::printf("action cancel -> zero cmd_vel after %.3f s\n", stop_wall - cancelled);
+  EXPECT_LT(stop_wall - cancelled, 0.5);
+
+  // 3. rostopic only: ~start with a sketch path, then ~cancel.
+  if (std::system("command -v rostopic >/dev/null 2>&1") == 0) {
+    const double t3 = wallNow();
+    const std::string pub = "rostopic pub -1 /sketchnav_nav/start std_msgs/String \"data: '" +
+                            goal.sketch + "'\" >/dev/null 2>&1";
+    ASSERT_EQ(std::system(pub.c_str()), 0);
+    ASSERT_TRUE(waitFor([&] { return movingSince(t3) || !nav_->running(); }, 120)) << logs();
+    const double t4 = wallNow();
+    ASSERT_EQ(std::system("rostopic pub -1 /sketchnav_nav/cancel std_msgs/Empty '{}' "
+                          ">/dev/null 2>&1"),
+              0);
+    ASSERT_TRUE(waitFor(
+        [&] {
+          std::lock_guard<std::mutex> l(seen.m);
+          return seen.last_result.find("\"cancelled\"") != std::string::npos;
+        },
+        15))
+        << logs();
+    const auto c = commands();
+    ASSERT_FALSE(c.empty());
+    EXPECT_EQ(c.back().v, 0.0);
+    EXPECT_EQ(c.back().w, 0.0);
+    EXPECT_GT(c.back().wall, t4);
+  }
+  // The server ends on SIGINT, exit 0.
+  nav_->signal(SIGINT);
+  ASSERT_TRUE(nav_->wait(15)) << logs();
+  EXPECT_EQ(nav_->exitCode(), 0) << logs();
+}
+
+// REP 105 odometry from tf: the simulator's nav_msgs/Odometry moved off /odom, the node takes
+// odom -> base_link from tf and still drives the short route.
+TEST_F(RosTest, OdometryFromTfDrivesTheShortLabRoute) {
+  const std::string sketch = shortLabSketch(dir_);
+  sim_ = std::make_unique<Process>(cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1",
+                                        "--rate", "1", "odom:=odom_hidden"}),
+                                   (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
+  ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20)) << logs();
+  startNav(sketch, {"--max-time", "60", "--set", "ros.odom_source=tf", "--set",
+                    "ros.wait_s=20"});
+  ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
+  EXPECT_EQ(nav_->exitCode(), 0) << logs();
+  const Json r = Json::parse(nav_->out());
+  EXPECT_TRUE(r["success"].get<bool>()) << r["reason"] << logs();
+  EXPECT_NE(r["ros"]["base"].get<std::string>().find("&tf=odom"), std::string::npos)
+      << r["ros"].dump();
+  EXPECT_GT(r["odom_path_m"].get<double>(), 2.0);
+  // A topic source on the hidden topic would have waited for /odom and failed.
+  EXPECT_EQ(nav_->err().find("no odometry message on /odom"), std::string::npos);
+}
+
+// The launch files parse with roslaunch's own loader: the simulator + node pair on simulated
+// time, and the real robot's remappings.
+TEST(RosLaunch, LaunchFilesParse) {
+  if (std::system(SKETCHNAV_ROS_PYTHON " -c 'import roslaunch' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-roslaunch not installed";
+  const fs::path dir =
+      fs::temp_directory_path() / ("sketchnav-test-ros-launch-" + std::to_string(::getpid()));
+  fs::create_directories(dir);
+  const std::string pkg = std::string(SKETCHNAV_ROS_LAUNCH_DIR) + "/..";
+  auto load = [&](const std::string& file) {
+    const std::string out = (dir / "out.json").string();
+    const std::string c = "ROS_HOME=" + dir.string() + " ROS_PACKAGE_PATH=" + pkg + " " +
+                          SKETCHNAV_ROS_PYTHON + " " + pkg + "/scripts/launch_summary.py " +
+                          SKETCHNAV_ROS_LAUNCH_DIR + "/" + file + " > " + out + " 2>" +
+                          (dir / "err.txt").string();
+    EXPECT_EQ(std::system(c.c_str()), 0) << slurp((dir / "err.txt").string());
+    return Json::parse(slurp(out));
+  };
+  const Json sim = load("sim_nav.launch");
+  ASSERT_EQ(sim["nodes"].size(), 2u) << sim.dump(1);
+  EXPECT_EQ(sim["params"]["/use_sim_time"], true);
+  std::map<std::string, Json> nodes;
+  for (const auto& n : sim["nodes"]) nodes[n["name"].get<std::string>()] = n;
+  ASSERT_TRUE(nodes.count("sketchnav_sim") && nodes.count("sketchnav_nav")) << sim.dump(1);
+  EXPECT_EQ(nodes["sketchnav_sim"]["args"].get<std::string>().rfind("ros sim", 0), 0u);
+  const std::string nav_args = nodes["sketchnav_nav"]["args"];
+  EXPECT_EQ(nav_args.rfind("ros nav --sketch ", 0), 0u) << nav_args;
+  // $(find sketchnav) resolved to this source tree's sketch.
+  const std::string sk = nav_args.substr(17, nav_args.find(' ', 17) - 17);
+  EXPECT_TRUE(fs::exists(sk)) << sk;
+  const Json robot = load("robot.launch");
+  ASSERT_EQ(robot["nodes"].size(), 1u);
+  const Json& remap = robot["nodes"][0]["remap"];
+  EXPECT_EQ(remap["cmd_vel"], "/RosAria/cmd_vel");
+  EXPECT_EQ(remap["odom"], "/RosAria/pose");
+  EXPECT_EQ(robot["params"]["/sketchnav_nav/ros/sonar_topic"], "");
+  // The settings the launch files set are settings the node takes (strict check).
+  for (const Json* j : {&sim, &robot})
+    for (const auto& [k, v] : (*j)["params"].items())
+      if (k.rfind("/sketchnav_nav/", 0) == 0) {
+        Json c;
+        std::string key = k.substr(15);
+        std::replace(key.begin(), key.end(), '/', '.');
+        EXPECT_TRUE(key.rfind("ros.", 0) == 0 || key.rfind("nav.", 0) == 0) << key;
+      }
+  // roslaunch's command line agrees.
+  if (std::system("command -v roslaunch >/dev/null 2>&1") == 0) {
+    const std::string c = "ROS_HOME=" + dir.string() + " ROS_PACKAGE_PATH=" + pkg +
+                          " roslaunch --nodes " + SKETCHNAV_ROS_LAUNCH_DIR +
+                          "/sim_nav.launch > " + (dir / "nodes.txt").string() + " 2>&1";
+    EXPECT_EQ(std::system(c.c_str()), 0) << slurp((dir / "nodes.txt").string());
+    const std::string n = slurp((dir / "nodes.txt").string());
+    EXPECT_NE(n.find("/sketchnav_sim"), std::string::npos) << n;
+    EXPECT_NE(n.find("/sketchnav_nav"), std::string::npos) << n;
+  }
+  fs::remove_all(dir);
+}
+
+// Image-to-command latency through ROS (doc/ros.md "Latency"): this process is a wall-time
+// robot publishing 640x480 frames at 10 Hz; the node's summary splits the latency into
+// transport (stamp -> callback), waiting for the executive's grab, and grab -> command (the
+// in-process path). A benchmark figure: the test checks only that it was measured.
+TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
+  auto img_pub = nh_->advertise<sensor_msgs::Image>("image_raw", 2);
+  auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
+  auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
+  std::atomic<bool> stop{false};
+  cv::Mat noise(480, 640, CV_8UC3);
+  cv::theRNG().state = 26;
+  cv::randu(noise, cv::Scalar::all(0), cv::Scalar::all(255));
+  cv::GaussianBlur(noise, noise, {0, 0}, 3);
+  std::thread robot([&] {
+    double next_img = 0;
+    while (!stop) {
+      const ros::Time now = ros::Time::now();
+      if (wallNow() >= next_img) {
+        next_img = wallNow() + 0.1;
+        sensor_msgs::Image im;
+        im.header.stamp = now;
+        im.header.frame_id = "base_link";
+        im.width = 640;
+        im.height = 480;
+        im.encoding = "bgr8";
+        im.step = 640 * 3;
+        im.data.assign(noise.data, noise.data + 640 * 480 * 3);
+        img_pub.publish(im);
+        sensor_msgs::CameraInfo ci;
+        ci.header = im.header;
+        ci.width = 640;
+        ci.height = 480;
+        ci.K = {554, 0, 319.5, 0, 554, 239.5, 0, 0, 1};
+        info_pub.publish(ci);
+      }
+      nav_msgs::Odometry od;
+      od.header.stamp = now;
+      od.pose.pose.orientation.w = 1;
+      odom_pub.publish(od);
+      std::this_thread::sleep_for(std::chrono::milliseconds(20));
+    }
+  });
+  startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set", "ros.scan_topic=",
+                                  "--set", "ros.camera_mount_from_tf=false", "--max-time", "60"});
+  const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
+  if (started && nav_->running()) std::this_thread::sleep_for(std::chrono::seconds(8));
+  nav_->signal(SIGINT);
+  const bool ended = nav_->wait(15);
+  stop = true;
+  robot.join();
+  ASSERT_TRUE(started && ended) << logs();
+  const Json r = Json::parse(nav_->out());
+  const Json& L = r["ros"]["latency"];
+  ASSERT_GT(L["frames"].get<int>(), 5) << L.dump(1) << logs();
+  ASSERT_FALSE(L["transport"].is_null()) << L.dump(1);
+  for (const char* k : {"transport", "wait", "grab_to_cmd", "total", "ros_overhead"})
+    EXPECT_GE(L[k]["mean_ms"].get<double>(), 0.0) << k;
+  EXPECT_GE(L["total"]["mean_ms"].get<double>(), L["grab_to_cmd"]["mean_ms"].get<double>());
+  std::printf(
+      "latency over %d frames [ms, mean / p95]: transport %.2f / %.2f, wait %.2f / %.2f, "
+      "grab->cmd %.2f / %.2f, total %.2f / %.2f, ROS overhead %.2f / %.2f\n",
+      L["frames"].get<int>(), L["transport"]["mean_ms"].get<double>(),
+      L["transport"]["p95_ms"].get<double>(), L["wait"]["mean_ms"].get<double>(),
+      L["wait"]["p95_ms"].get<double>(), L["grab_to_cmd"]["mean_ms"].get<double>(),
+      L["grab_to_cmd"]["p95_ms"].get<double>(), L["total"]["mean_ms"].get<double>(),
+      L["total"]["p95_ms"].get<double>(), L["ros_overhead"]["mean_ms"].get<double>(),
+      L["ros_overhead"]["p95_ms"].get<double>());
+  RecordProperty("ros_overhead_mean_us",
+                 static_cast<int>(L["ros_overhead"]["mean_ms"].get<double>() * 1000));
+}

@@ -4,6 +4,7 @@
 // registerDrivers() subscribe / publish through it:
 //   ros://camera?topic=image_raw&info=camera_info   sensor_msgs/Image (+ CameraInfo)
 //   ros://base?cmd_vel=cmd_vel&odom=odom            geometry_msgs/Twist out, nav_msgs/Odometry in
+//   ros://base?cmd_vel=cmd_vel&tf=odom              ... odometry from tf odom -> base_link
 //   ros://laser?topic=scan                          sensor_msgs/LaserScan
 //   ros://sonar?topic=sonar                         sensor_msgs/Range, one frame per transducer
 // so `sketchnav ros nav` runs the unchanged executive (nav/) on a ROS robot. Topic names are
@@ -16,6 +17,7 @@
 // publisher went away, the master cannot be reached, or SIGINT / SIGTERM arrived. The ros://
 // base then reports ok() == false, so the executive stops and fails the run with that reason.
 // Nothing the node publishes moves the robot after a fault (the process ends with the route).
+#include <cstdint>
 #include <memory>
 #include <string>
 #include <vector>
@@ -37,6 +39,9 @@ struct RosParams {
   std::string sonar_topic = "sonar";  // "" = no sonar
   std::string cmd_vel_topic = "cmd_vel";
   std::string base_frame = "base_link";
+  std::string odom_source = "topic";  // "topic": nav_msgs/Odometry on odom_topic; "tf": the
+                                      // transform odom_frame -> base_frame (REP 105)
+  std::string odom_frame = "odom";    // the odometry frame (tf source; pose, route, markers)
   bool camera_mount_from_tf = true;  // servo.camera_x_m/z_m, nav.perception.camera_yaw/pitch
                                      // from tf base_frame -> the image's frame, unless set
   template <class B>
@@ -51,6 +56,8 @@ struct RosParams {
     b("sonar_topic", sonar_topic);
     b("cmd_vel_topic", cmd_vel_topic);
     b("base_frame", base_frame);
+    b("odom_source", odom_source);
+    b("odom_frame", odom_frame);
     b("camera_mount_from_tf", camera_mount_from_tf);
   }
   void validate() const;  // InputError "ros.<field> = ...: ..."
@@ -81,6 +88,9 @@ std::string fault();
 void sendZeroCommand();
 /// Trips the watchdog by hand (zero Twist now, every later command zero).
 void trip(const std::string& reason);
+/// Clears a latched fault (a new goal after a safety stop): commands pass again. A cause
+/// still present (master gone, an input stale) trips it again at the next watchdog check.
+void resetFault();
 
 /// The ROS clock (simulated when /use_sim_time is set): now() = ros::Time::now();
 /// sleepUntil() returns early once the watchdog has tripped, so a frozen /clock cannot hang
@@ -88,6 +98,15 @@ void trip(const std::string& reason);
 std::shared_ptr<hw::Clock> clock();
 /// Waits (wall) until ROS time is valid (a first /clock under use_sim_time). False on timeout.
 bool waitForTime(double timeout_s);
+
+/// Image-to-command latency (doc/ros.md "Latency"). The perception tap calls this with the
+/// seq of each frame it examined; the ros:// base's next command closes the measurement.
+void noteObservation(std::uint64_t frame_seq);
+/// The measurements so far: frames, and mean / p95 [ms] of transport (image stamp -> the
+/// node's callback; null under simulated time, where stamps are not wall time), wait
+/// (callback -> the executive's grab), grab_to_cmd (the in-process path: grab -> the command
+/// sent), total (stamp or callback -> command) and ros_overhead (total - grab_to_cmd).
+Json latencySummary();
 
 /// Registers the ros:// camera, base and range drivers with hw::Registry. Idempotent.
 void registerDrivers();
