@@ -298,6 +298,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
       s["ros"] = {{"fault", f},
                   {"signal", ros::signalReceived()},
                   {"base", base_uri},
+                  {"settings", paramsToJson(rp)},
                   {"goal_from", goal.source},
                   {"latency", ros::latencySummary()}};
       // A fault while the route ran failed it (the base reported it lost); say what it was.

@@ -172,7 +172,7 @@ class RosCamera final : public hw::Camera {
       ++st_.received;
       std::lock_guard<std::mutex> ll(state().latency_mutex);
       auto& fr = state().latency.frames;
-      fr[seq_] = {recv, -1, transport};
+      fr[seq_] = {recv, wallNow(), -1, transport};
       while (fr.size() > 50) fr.erase(fr.begin());
     }
     cv_.notify_all();
@@ -296,7 +296,8 @@ class RosBase final : public hw::Base {
     const auto it = L.frames.find(L.pending_seq);
     if (it == L.frames.end() || it->second.grab < 0) return;
     const auto& f = it->second;
-    L.wait.push_back(f.grab - f.recv);
+    L.convert.push_back(f.ready - f.recv);
+    L.wait.push_back(f.grab - f.ready);
     L.grab_to_cmd.push_back(now - f.grab);
     if (f.transport >= 0) L.transport.push_back(f.transport);
     L.total.push_back(now - f.recv + std::max(0.0, f.transport));
@@ -364,7 +365,7 @@ class RosBase final : public hw::Base {
     const double stamp = stampOf(direct->header.stamp);
     {
       std::lock_guard<std::mutex> l(m_);
-      if (have_ && stamp <= odom_.stamp) return;  // an old transform again
+      if (have_ && stamp < odom_.stamp) return;  // an older transform (a late message)
     }
     in_->wall_last = wallNow();
     const auto& p = direct->transform.translation;
@@ -671,6 +672,7 @@ Json latencySummary() {
   for (size_t i = 0; i < L.total.size(); ++i) over.push_back(L.total[i] - L.grab_to_cmd[i]);
   return {{"frames", L.total.size()},
           {"transport", ms(L.transport)},
+          {"convert", ms(L.convert)},
           {"wait", ms(L.wait)},
           {"grab_to_cmd", ms(L.grab_to_cmd)},
           {"total", ms(L.total)},

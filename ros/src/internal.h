@@ -30,13 +30,13 @@ struct Input {
 /// Image-to-command latency samples (node.h latencySummary()).
 struct Latency {
   struct FrameTimes {
-    double recv = -1, grab = -1;  // [s, wallNow()]
+    double recv = -1, ready = -1, grab = -1;  // [s, wallNow()] callback, converted, grabbed
     double transport = -1;        // [s] stamp -> callback (wall-time robots only)
   };
   std::map<std::uint64_t, FrameTimes> frames;  // by camera seq, the last ~50
   bool pending = false;
   std::uint64_t pending_seq = 0;
-  std::vector<double> transport, wait, grab_to_cmd, total;  // [s]
+  std::vector<double> transport, convert, wait, grab_to_cmd, total;  // [s]
 };
 
 struct State {

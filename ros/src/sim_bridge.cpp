@@ -298,6 +298,16 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
       }
       clockAt(clk->now());
       pub_odom.publish(odom_msg);
+      {  // odom -> base_link again too: a node taking odometry from tf may join late
+        const auto& p = odom_msg.pose.pose;
+        geometry_msgs::TransformStamped t;
+        t.header = odom_msg.header;
+        t.child_frame_id = odom_msg.child_frame_id;
+        t.transform.translation.x = p.position.x;
+        t.transform.translation.y = p.position.y;
+        t.transform.rotation = p.orientation;
+        if (!t.header.frame_id.empty()) tfb.sendTransform(t);
+      }
       pub_truth.publish(truth_msg);
       if (!scan_msg.ranges.empty()) pub_scan.publish(scan_msg);
       for (const auto& m : sonar_msgs) pub_sonar.publish(m);

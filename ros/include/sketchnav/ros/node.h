@@ -103,9 +103,10 @@ bool waitForTime(double timeout_s);
 /// seq of each frame it examined; the ros:// base's next command closes the measurement.
 void noteObservation(std::uint64_t frame_seq);
 /// The measurements so far: frames, and mean / p95 [ms] of transport (image stamp -> the
-/// node's callback; null under simulated time, where stamps are not wall time), wait
-/// (callback -> the executive's grab), grab_to_cmd (the in-process path: grab -> the command
-/// sent), total (stamp or callback -> command) and ros_overhead (total - grab_to_cmd).
+/// node's callback; null under simulated time, where stamps are not wall time), convert
+/// (the callback's checks and cv_bridge copy), wait (converted -> the executive's grab),
+/// grab_to_cmd (the in-process path: grab -> the command sent), total (stamp, or callback
+/// under simulated time, -> command) and ros_overhead (total - grab_to_cmd).
 Json latencySummary();
 
 /// Registers the ros:// camera, base and range drivers with hw::Registry. Idempotent.
