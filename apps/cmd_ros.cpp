@@ -250,6 +250,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
 
     // One route: the goal's sketch and model (else --model) on the ros:// devices.
     auto runGoal = [&](const ros::RouteGoal& goal) -> Json {
+      if (goal.sketch.empty()) throw InputError("the goal names no sketch file");
       ros::resetFault();  // a new goal after a safety stop may move the robot again
       RouteView view;
       view.out = &outputs;

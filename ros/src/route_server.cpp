@@ -46,6 +46,10 @@ struct RouteServer::Impl {
     } else {
       g.sketch = d;
     }
+    if (g.sketch.empty()) {
+      log::error("ros", "~start: no sketch given (a path, or JSON {\"sketch\": ...}): ignored");
+      return;
+    }
     std::lock_guard<std::mutex> l(this->m);
     if (active) cancel = true;  // preempts the running route, as an action goal does
     topic_goals.push_back(g);

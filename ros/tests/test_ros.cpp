@@ -1036,3 +1036,104 @@ TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
   RecordProperty("ros_overhead_mean_us",
                  static_cast<int>(L["ros_overhead"]["mean_ms"].get<double>() * 1000));
 }
+
+// A safety stop in server mode ends that route and keeps the robot still; only a new goal
+// moves it again. This process is the robot (wall time, 20 Hz), as in RosGarbage.
+TEST_F(RosTest, AfterAFaultNothingMovesUntilANewGoal) {
+  auto img_pub = nh_->advertise<sensor_msgs::Image>("image_raw", 2);
+  auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
+  auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
+  auto start_pub = nh_->advertise<std_msgs::String>("/sketchnav_nav/start", 1, true);
+  std::string last_result;
+  std::mutex rm;
+  auto result_sub = nh_->subscribe<std_msgs::String>(
+      "/sketchnav_nav/result", 2, [&](const std_msgs::StringConstPtr& s) {
+        std::lock_guard<std::mutex> l(rm);
+        last_result = s->data;
+      });
+  std::atomic<bool> stop{false}, nan_once{false};
+  std::thread robot([&] {
+    while (!stop) {
+      const ros::Time now = ros::Time::now();
+      sensor_msgs::Image im;
+      im.header.stamp = now;
+      im.header.frame_id = "base_link";
+      im.width = 64;
+      im.height = 48;
+      im.encoding = "bgr8";
+      im.step = 64 * 3;
+      im.data.assign(64 * 48 * 3, 90);
+      img_pub.publish(im);
+      sensor_msgs::CameraInfo ci;
+      ci.header = im.header;
+      ci.width = 64;
+      ci.height = 48;
+      ci.K = {55, 0, 31.5, 0, 55, 23.5, 0, 0, 1};
+      info_pub.publish(ci);
+      nav_msgs::Odometry od;
+      od.header.stamp = now;
+      od.pose.pose.orientation.w = 1;
+      if (nan_once.exchange(false))
+        od.pose.pose.position.x = std::numeric_limits<double>::quiet_NaN();
+      odom_pub.publish(od);
+      std::this_thread::sleep_for(std::chrono::milliseconds(50));
+    }
+  });
+  nav_ = std::make_unique<Process>(
+      cmd({"ros", "nav", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR, "--set", "ros.sonar_topic=",
+           "--set", "ros.scan_topic=", "--set", "ros.camera_mount_from_tf=false"}),
+      (dir_ / "nav.out").string(), (dir_ / "nav.err").string());
+  const std::string sketch = shortLabSketch(dir_);
+  auto movingSince = [&](double t) {
+    for (const auto& c : commands())
+      if (c.wall > t && std::abs(c.v) > 0.05) return true;
+    return false;
+  };
+  auto startRoute = [&] {
+    std_msgs::String m;
+    m.data = sketch;
+    start_pub.publish(m);
+  };
+  // The server subscribes to ~start once it is up (the latched message reaches it then).
+  const double t0 = wallNow();
+  startRoute();
+  const bool moved = waitFor([&] { return movingSince(t0) || !nav_->running(); }, 120);
+  if (!moved || !nav_->running()) {
+    stop = true;
+    robot.join();
+    FAIL() << "the first route did not start" << logs();
+  }
+  const double t_nan = wallNow();
+  nan_once = true;  // one garbage odometry message: a safety stop
+  const bool failed = waitFor(
+      [&] {
+        std::lock_guard<std::mutex> l(rm);
+        return last_result.find("safety_stop") != std::string::npos;
+      },
+      10);
+  // The robot stays still while the node waits (2 s), with the robot's topics all healthy:
+  // no motion command after the first zero one that followed the garbage.
+  std::this_thread::sleep_for(std::chrono::milliseconds(2000));
+  double zero_wall = -1;
+  for (const auto& c : commands())
+    if (c.wall > t_nan && c.v == 0.0 && c.w == 0.0) {
+      zero_wall = c.wall;
+      break;
+    }
+  const bool still = zero_wall > 0 && !movingSince(zero_wall);
+  // A new goal moves it again.
+  const double t1 = wallNow();
+  startRoute();
+  const bool again = waitFor([&] { return movingSince(t1) || !nav_->running(); }, 120);
+  nav_->signal(SIGINT);
+  const bool ended = nav_->wait(15);
+  stop = true;
+  robot.join();
+  EXPECT_TRUE(failed) << "no safety_stop result after NaN odometry: " << last_result << logs();
+  EXPECT_NE(nav_->err().find("odometry on /odom: NaN"), std::string::npos) << logs();
+  EXPECT_TRUE(still) << "a command moved the robot after the fault" << logs();
+  EXPECT_TRUE(again) << "the new goal did not move the robot" << logs();
+  EXPECT_NE(nav_->err().find("fault cleared for a new goal"), std::string::npos) << logs();
+  ASSERT_TRUE(ended) << logs();
+  EXPECT_EQ(nav_->exitCode(), 0) << logs();
+}
