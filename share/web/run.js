@@ -488,7 +488,7 @@ function obsAt(t) {
 const PLOTS = [
   { name: 'ω', unit: 'rad/s', color: '#2f6fde', get: () => series.ticks.map((r) => [r[0], r[2]]), sym: true },
   { name: 'v', unit: 'm/s', color: '#1f9d55', get: () => series.ticks.map((r) => [r[0], r[1]]) },
-  { name: 'x_t − x_d', unit: 'px', color: '#d2691e', get: () => series.ticks.map((r) => [r[0], r[3]]), sym: true },
+  { name: 'x_t − x_d', unit: '', color: '#d2691e', get: () => series.ticks.map((r) => [r[0], r[3]]), sym: true },
   { name: 'inliers', unit: '', color: '#7b3fbf', get: () => series.obs.map((r) => [r[0], r[1]]), dots: true },
   { name: 'perception', unit: 'ms', color: '#9b5b00', get: () => series.obs.map((r) => [r[0], r[2]]), dots: true },
 ];
