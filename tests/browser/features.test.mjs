@@ -496,7 +496,7 @@ try {
         await t.screenshot({ path: path.join(out, `features-tablet-editor-${w}x${h}.png`) });
         await t.goto(url + 'run.html');
         await t.waitForSelector('#world option[value="corridor"]', { state: 'attached' });
-        await t.waitForFunction(() => !document.getElementById('run-card').hidden);
+        await t.waitForTimeout(500);
         await fits('run page');
         const cam = await t.locator('#camera-wrap').boundingBox(), plots = await t.locator('#plots').boundingBox(), stop = await t.locator('#stop').boundingBox();
         assert.ok(cam.width >= 400 && cam.height >= 220, `camera ${cam.width}x${cam.height}`);
