@@ -56,6 +56,8 @@ std::string sketchFor(const ui::RunRequest& rq) {
   return resourcePath("sketches/" + w + ".sketch.json");
 }
 
+Json worldGeometry(const std::string& world);
+
 // What the page's map shows, in the odometry frame (origin at the start, x along the
 // robot's initial heading) where the executive's pose estimate lives: the sketch as the
 // executive aligns it (start on the robot, first section along its heading) and, in
@@ -91,8 +93,18 @@ Json mapGeometry(const ui::RunRequest& rq) {
     g["guide_points"] = guides;
     g["sketch_landmarks"] = lms;
   }
-  if (!rq.hardware()) {
-    const sim::World w = sim::loadWorldByName(rq.world);
+  if (!rq.hardware()) g.update(worldGeometry(rq.world));
+  return g;
+}
+
+// A simulated world seen from its start pose (the odometry frame: origin at the start, x along
+// the start heading): floor, walls (closed doors too), obstacles, landmarks and the goal.
+Json worldGeometry(const std::string& world) {
+  using V = Eigen::Vector2d;
+  auto pt = [](const V& p) { return Json::array({p.x(), p.y()}); };
+  Json g = {{"frame", "odometry"}};
+  {
+    const sim::World w = sim::loadWorldByName(world);
     const double c = std::cos(-w.start.theta), s = std::sin(-w.start.theta);
     auto toOdom = [&](const V& p) {
       const V d = p - V(w.start.x, w.start.y);
@@ -128,7 +140,7 @@ Json mapGeometry(const ui::RunRequest& rq) {
       lms.push_back({{"id", l.id}, {"class", l.class_name}, {"x", p.x()}, {"y", p.y()}});
     }
     const V goal = toOdom(w.goal.centre);
-    g["world"] = rq.world;
+    g["world"] = world;
     g["floor"] = floor;
     g["walls"] = walls;
     g["obstacles"] = obst;
@@ -186,6 +198,7 @@ Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::str
   o.on_tick = h.on_tick;
   o.on_observation = h.on_observation;
   o.stop_requested = h.stop_requested;
+  o.out_dir = h.out_dir;  // the run folder `sketchnav run` writes, for the page's record
   try {
     h.on_map(mapGeometry(rq));
   } catch (const std::exception& e) {
@@ -235,6 +248,10 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("capture-dir",
               "where the run page saves captured photos, one folder per class (default: "
               "$XDG_DATA_HOME/sketchnav/captures; give the --landmarks folder to train on them)")
+      .option("runs-dir",
+              "where every run started from the page writes its folder (summary.json, "
+              "trajectory.png, telemetry.csv, events.jsonl; default: "
+              "$XDG_DATA_HOME/sketchnav/runs)")
       .option("model-cache", "landmark model cache directory (default: ~/.cache/sketchnav)")
       .option("host", "address to bind (only loopback is safe)", "127.0.0.1")
       .option("port", "TCP port (0 = any free port)", "8080")
@@ -268,6 +285,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
       boxes.push_back(w.box);
     return boxes;
   };
+  ro.runs_dir = args.has("runs-dir") ? args.get("runs-dir") : userDataDir() + "/runs";
   ro.capture_dir = args.has("capture-dir") ? args.get("capture-dir") : userDataDir() + "/captures";
   {
     std::error_code ec;
@@ -288,6 +306,18 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   ui::Server server(so);
   ui::addEditorRoutes(server, eo);
   ui::addRunRoutes(server, runs);
+  // The editor's background: a world offered on the run page, as the robot starts in it.
+  server.get(R"(/api/worlds/([^/]+)/map)", [worlds = ro.worlds](const httplib::Request& req,
+                                                               httplib::Response& res) {
+    const std::string name = req.matches[1];
+    if (std::find(worlds.begin(), worlds.end(), name) == worlds.end())
+      return ui::sendError(res, 404, "world map: 'world' '" + name.substr(0, 60) +
+                                         "' is not one of the worlds offered");
+    Json g = worldGeometry(name);
+    const sim::World w = sim::loadWorldByName(name);
+    g["start_world"] = {{"x", w.start.x}, {"y", w.start.y}, {"theta", w.start.theta}};
+    ui::sendJson(res, g);
+  });
   server.bind();
   if (so.host != "127.0.0.1" && so.host != "localhost" && so.host != "::1")
     log::warn("ui", "listening beyond this machine: anyone who can reach it can drive the robot",
@@ -296,12 +326,14 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
     printJson({{"url", server.url()},
                {"port", server.port()},
                {"sketch_dir", fs::absolute(eo.sketch_dir).string()},
-               {"capture_dir", fs::absolute(ro.capture_dir).string()}});
+               {"capture_dir", fs::absolute(ro.capture_dir).string()},
+               {"runs_dir", fs::absolute(ro.runs_dir).string()}});
   else
     std::cout << "sketchnav ui: editor at " << server.url() << ", live run at " << server.url()
               << "run.html; sketches in " << fs::absolute(eo.sketch_dir).string()
               << ", captures to " << fs::absolute(ro.capture_dir).string()
-              << (ro.captures_train ? " (the landmark set)" : "") << " (Ctrl+C to stop)"
+              << (ro.captures_train ? " (the landmark set)" : "") << ", runs recorded in "
+              << fs::absolute(ro.runs_dir).string() << " (Ctrl+C to stop)"
               << std::endl;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);

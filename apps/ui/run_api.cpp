@@ -10,12 +10,16 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <array>
 #include <filesystem>
+#include <fstream>
 #include <map>
 #include <regex>
+#include <sstream>
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/core/paths.h"
 
 namespace fs = std::filesystem;
 
@@ -141,6 +145,14 @@ struct RunController::Live {
   std::map<std::string, Json> landmarks;  // id -> {id, class, section, state, ...}
   std::vector<std::pair<double, double>> trajectory;
   Json map_geometry;
+  // run record and progress
+  std::string run_dir;  // this run's folder ("" = none)
+  std::vector<std::array<double, 8>> ticks;  // t v w servo_error(NaN) x y theta section
+  std::vector<std::array<double, 3>> obs;    // t inliers(best) perception_ms
+  std::vector<std::pair<double, double>> guides;  // the route's guide points (odometry frame)
+  double along_m = 0;                             // progress along them [m]
+  double first_tick_wall = 0, first_tick_t = 0;   // for the real-time factor
+  double last_tick_wall = 0;
   // camera
   cv::Mat frame;
   std::uint64_t frame_seq = 0;
@@ -178,6 +190,12 @@ struct RunController::Live {
     landmarks.clear();
     trajectory.clear();
     map_geometry = nullptr;
+    run_dir.clear();
+    ticks.clear();
+    obs.clear();
+    guides.clear();
+    along_m = 0;
+    first_tick_wall = first_tick_t = last_tick_wall = 0;
     frame.release();
     frame_seq = frames = 0;
     frame_wall = 0;
@@ -361,6 +379,26 @@ void RunController::join() {
   if (thread_.joinable()) thread_.join();
 }
 
+std::string RunController::newRunDir(const RunRequest& request) const {
+  std::string stamp = utcTimestamp();
+  for (char& c : stamp)
+    if (c == ':') c = '-';
+  std::string what = request.hardware() ? "robot" : fs::path(request.world).filename().string();
+  if (what.size() > 11 && what.substr(what.size() - 11) == ".world.json")
+    what = what.substr(0, what.size() - 11);
+  for (char& c : what)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '_') c = '_';
+  if (what.size() > 40) what.resize(40);
+  const std::string name = stamp + "-" + what;
+  fs::path dir = fs::path(opt_.runs_dir) / name;
+  // Two runs in the same second get distinct folders rather than mixing outputs.
+  for (int i = 2; fs::exists(dir); ++i) dir = fs::path(opt_.runs_dir) / (name + "-" + std::to_string(i));
+  std::error_code ec;
+  fs::create_directories(dir, ec);
+  if (ec) throw RuntimeError("runs folder: cannot create " + dir.string() + ": " + ec.message());
+  return dir.string();
+}
+
 void RunController::start(const RunRequest& request) {
   std::lock_guard<std::mutex> l(start_mutex_);
   {
@@ -370,9 +408,13 @@ void RunController::start(const RunRequest& request) {
       throw InputError("a run is already going: stop it first");
   }
   if (thread_.joinable()) thread_.join();  // the previous run has finished
+  // The run's folder, as `sketchnav run` writes it: <runs_dir>/<UTC time>-<world or robot>.
+  std::string run_dir;
+  if (!opt_.runs_dir.empty() && !request.camera_only) run_dir = newRunDir(request);
   {
     std::lock_guard<std::mutex> ll(live_->m);
     live_->reset();
+    live_->run_dir = run_dir;
     live_->request = request.toJson();
     live_->hardware = request.hardware();
     live_->started_wall = wallNow();
@@ -428,9 +470,34 @@ void RunController::runThread(RunRequest request) {
     }
   };
   h.on_tick = [live](const nav::TelemetryRow& r) {
+    const double now = wallNow();
     std::lock_guard<std::mutex> l(live->m);
+    if (!live->has_tick) {
+      live->first_tick_wall = now;
+      live->first_tick_t = r.t;
+    }
     live->tick = r;
     live->has_tick = true;
+    live->last_tick_wall = now;
+    live->ticks.push_back({r.t, r.v_cmd, r.w_cmd,
+                           std::isfinite(r.servo_error) ? r.servo_error : std::nan(""), r.odom.x,
+                           r.odom.y, r.odom.theta, static_cast<double>(r.section)});
+    // Progress: the pose projected on the guide segment of the section being driven.
+    const auto& g = live->guides;
+    if (g.size() >= 2) {
+      const int k = std::clamp(r.section, 0, static_cast<int>(g.size()) - 2);
+      double before = 0;
+      for (int i = 0; i < k; ++i)
+        before += std::hypot(g[i + 1].first - g[i].first, g[i + 1].second - g[i].second);
+      const double dx = g[k + 1].first - g[k].first, dy = g[k + 1].second - g[k].second;
+      const double len2 = dx * dx + dy * dy;
+      const double u =
+          len2 > 0
+              ? std::clamp(((r.odom.x - g[k].first) * dx + (r.odom.y - g[k].second) * dy) / len2,
+                           0.0, 1.0)
+              : 0.0;
+      live->along_m = before + u * std::sqrt(len2);
+    }
     if (live->status == "starting") live->status = "running";
     const auto& tr = live->trajectory;
     if (tr.empty() || std::hypot(tr.back().first - r.odom.x, tr.back().second - r.odom.y) > 0.05)
@@ -444,6 +511,9 @@ void RunController::runThread(RunRequest request) {
     live->detections_seq = f.seq;
     live->windows = o.timing.windows;
     live->perception_ms = o.timing.total_ms;
+    live->obs.push_back({live->has_tick ? live->tick.t : 0.0,
+                         o.detections.empty() ? 0.0 : static_cast<double>(o.detections[0].inliers),
+                         o.timing.total_ms});
   };
   h.wrap_camera = [live](std::unique_ptr<hw::Camera> c) -> std::unique_ptr<hw::Camera> {
     return std::make_unique<TapCamera>(std::move(c), live);
@@ -458,7 +528,16 @@ void RunController::runThread(RunRequest request) {
   h.on_map = [live](const Json& m) {
     std::lock_guard<std::mutex> l(live->m);
     live->map_geometry = m;
+    live->guides.clear();
+    if (m.is_object() && m.contains("guide_points"))
+      for (const auto& p : m["guide_points"])
+        if (p.is_array() && p.size() == 2)
+          live->guides.emplace_back(p[0].get<double>(), p[1].get<double>());
   };
+  {
+    std::lock_guard<std::mutex> l(live->m);
+    h.out_dir = live->run_dir;
+  }
 
   Json summary;
   std::string status, reason;
@@ -471,6 +550,12 @@ void RunController::runThread(RunRequest request) {
     status = "error";
     reason = e.what();
     log::error("ui", "run failed", {{"error", reason}});
+    // The record of the run says why there is nothing else in its folder.
+    if (!h.out_dir.empty() && !fs::exists(fs::path(h.out_dir) / "summary.json")) {
+      summary = {{"success", false}, {"error", true}, {"reason", reason},
+                 {"request", request.toJson()}, {"out_dir", h.out_dir}};
+      std::ofstream(fs::path(h.out_dir) / "summary.json") << summary.dump(2) << "\n";
+    }
   }
   std::lock_guard<std::mutex> l(live->m);
   live->summary = summary;
@@ -546,8 +631,37 @@ Json RunController::state() const {
   s["shown_seq"] = showObserved(L) ? L.detections_seq : L.frame_seq;
   s["events"] = Json(std::vector<Json>(L.events.begin(), L.events.end()));
   s["last_event"] = L.events.empty() ? Json(nullptr) : L.events.back();
-  s["summary"] = L.summary;
+  // The summary without its settings (the full one is the run folder's summary.json).
+  Json summary = L.summary;
+  if (summary.is_object()) summary.erase("settings");
+  s["summary"] = summary;
   s["elapsed_s"] = L.started_wall > 0 ? now - L.started_wall : 0.0;
+  // Where the run is written and how far along the route it is.
+  s["run_dir"] = L.run_dir;
+  s["run_id"] = L.run_dir.empty() ? std::string() : fs::path(L.run_dir).filename().string();
+  double route_m = 0;
+  for (size_t i = 1; i < L.guides.size(); ++i)
+    route_m += std::hypot(L.guides[i].first - L.guides[i - 1].first,
+                          L.guides[i].second - L.guides[i - 1].second);
+  Json prog = {{"along_m", L.along_m}, {"route_m", route_m}};
+  prog["fraction"] = route_m > 0 ? Json(std::clamp(L.along_m / route_m, 0.0, 1.0)) : Json(nullptr);
+  prog["remaining_m"] = route_m > 0 ? Json(std::max(0.0, route_m - L.along_m)) : Json(nullptr);
+  // Simulated (or robot) seconds per wall second since the first control tick.
+  const double wall_run = L.has_tick ? (active ? now : L.last_tick_wall) - L.first_tick_wall : 0;
+  prog["real_time_factor"] =
+      L.has_tick && wall_run > 0.5 ? Json((L.tick.t - L.first_tick_t) / wall_run) : Json(nullptr);
+  s["progress"] = prog;
+  // The attended landmark's class (its database photo is shown beside the live view).
+  std::string attended_class;
+  if (L.has_tick && !L.tick.landmark.empty()) {
+    const auto it = L.landmarks.find(L.tick.landmark);
+    if (it != L.landmarks.end() && it->second.contains("class"))
+      attended_class = it->second["class"].get<std::string>();
+    else if (L.map_geometry.is_object() && L.map_geometry.contains("sketch_landmarks"))
+      for (const auto& lm : L.map_geometry["sketch_landmarks"])
+        if (lm.value("id", "") == L.tick.landmark) attended_class = lm.value("class", "");
+  }
+  s["landmark_class"] = attended_class;
   return s;
 }
 
@@ -563,7 +677,27 @@ Json RunController::map() const {
   return m;
 }
 
-std::vector<unsigned char> RunController::frameJpeg() const {
+Json RunController::series(std::size_t from_tick, std::size_t from_obs) const {
+  const Live& L = *live_;
+  std::lock_guard<std::mutex> l(L.m);
+  auto num = [](double v) { return std::isfinite(v) ? Json(v) : Json(nullptr); };
+  Json ticks = Json::array(), obs = Json::array();
+  for (std::size_t i = from_tick; i < L.ticks.size(); ++i) {
+    Json row = Json::array();
+    for (double v : L.ticks[i]) row.push_back(num(v));
+    ticks.push_back(std::move(row));
+  }
+  for (std::size_t i = from_obs; i < L.obs.size(); ++i)
+    obs.push_back({L.obs[i][0], L.obs[i][1], L.obs[i][2]});
+  return {{"ticks", ticks},
+          {"obs", obs},
+          {"tick_rows", L.ticks.size()},
+          {"obs_rows", L.obs.size()},
+          {"columns", {"t", "v", "w", "servo_error", "x", "y", "theta", "section"}},
+          {"obs_columns", {"t", "inliers", "ms"}}};
+}
+
+std::vector<unsigned char> RunController::frameJpeg(const FrameOverlay& overlay) const {
   Live& L = *live_;
   cv::Mat img;
   std::vector<nav::Detection> dets;
@@ -598,7 +732,16 @@ std::vector<unsigned char> RunController::frameJpeg() const {
   }
   if (img.type() == CV_8UC1) cv::cvtColor(img, img, cv::COLOR_GRAY2BGR);
   const double fs = std::max(0.4, img.cols / 1000.0);
-  for (const auto& w : windows) cv::rectangle(img, w, cv::Scalar(230, 200, 60), 1, cv::LINE_AA);
+  if (overlay.windows >= 0 && windows.size() > static_cast<size_t>(overlay.windows))
+    windows.resize(overlay.windows);
+  if (overlay.detections >= 0 && dets.size() > static_cast<size_t>(overlay.detections))
+    dets.resize(overlay.detections);
+  if (!windows.empty()) {
+    // Faded: the windows say where perception looked, the detections what it found.
+    cv::Mat layer = img.clone();
+    for (const auto& w : windows) cv::rectangle(layer, w, cv::Scalar(230, 200, 60), 1, cv::LINE_AA);
+    cv::addWeighted(layer, 0.55, img, 0.45, 0, img);
+  }
   for (size_t i = 0; i < dets.size(); ++i) {
     const auto& d = dets[i];
     // The best detection (what the executive servos on) thick green, the others amber.
@@ -665,6 +808,63 @@ Json RunController::capture(const std::string& class_name, const std::optional<c
 
 // ---- routes --------------------------------------------------------------------------------
 
+namespace {
+// An integer query parameter in [lo, hi]; `fallback` when absent; InputError naming it.
+int queryInt(const httplib::Request& req, const char* name, int fallback, int lo, int hi) {
+  if (!req.has_param(name)) return fallback;
+  const std::string v = req.get_param_value(name);
+  static const std::regex num(R"(-?\d{1,10})");
+  long long x = 0;
+  if (std::regex_match(v, num)) x = std::stoll(v);
+  if (!std::regex_match(v, num) || x < lo || x > hi)
+    throw InputError(std::string("'") + name + "' must be an integer in " + std::to_string(lo) +
+                     ".." + std::to_string(hi) + " (got '" + v.substr(0, 20) + "')");
+  return static_cast<int>(x);
+}
+
+// A run folder named by a request: a plain folder name inside runs_dir, nothing else.
+fs::path runFolder(const std::string& runs_dir, const std::string& id) {
+  static const std::regex ok(R"([A-Za-z0-9][A-Za-z0-9_.-]{0,119})");
+  if (runs_dir.empty()) throw InputError("run: no runs folder configured");
+  if (!std::regex_match(id, ok) || id.find("..") != std::string::npos)
+    throw InputError("run: 'id' '" + id.substr(0, 60) + "' is not a run folder name");
+  return fs::path(runs_dir) / id;
+}
+
+// The run folders, newest first (names start with the UTC time), with their outcome.
+Json listRuns(const std::string& runs_dir) {
+  Json out = Json::array();
+  std::error_code ec;
+  if (runs_dir.empty() || !fs::is_directory(runs_dir, ec)) return out;
+  std::vector<std::string> names;
+  for (const auto& e : fs::directory_iterator(runs_dir, ec))
+    if (e.is_directory()) names.push_back(e.path().filename().string());
+  std::sort(names.rbegin(), names.rend());
+  if (names.size() > 100) names.resize(100);
+  for (const auto& n : names) {
+    const fs::path d = fs::path(runs_dir) / n;
+    Json r = {{"id", n}};
+    Json files = Json::array();
+    for (const char* f : {"summary.json", "trajectory.png", "telemetry.csv", "events.jsonl"})
+      if (fs::exists(d / f, ec)) files.push_back(f);
+    r["files"] = files;
+    try {
+      std::ifstream in(d / "summary.json");
+      if (in) {
+        const Json s = Json::parse(in);
+        for (const char* k : {"success", "reason", "world", "sketch", "time_s", "path_length_m",
+                              "distance_to_goal_m", "mode"})
+          if (s.contains(k)) r[k] = s[k];
+      }
+    } catch (const std::exception&) {
+      r["reason"] = "summary.json cannot be read";
+    }
+    out.push_back(r);
+  }
+  return out;
+}
+}  // namespace
+
 void addRunRoutes(Server& server, RunController& rc) {
   server.post("/api/run/start", [&rc](const httplib::Request& req, httplib::Response& res) {
     const RunRequest r = RunRequest::fromJson(parseJsonBody(req, "run request"));
@@ -681,10 +881,38 @@ void addRunRoutes(Server& server, RunController& rc) {
              [&rc](const httplib::Request&, httplib::Response& res) { sendJson(res, rc.state()); });
   server.get("/api/run/map",
              [&rc](const httplib::Request&, httplib::Response& res) { sendJson(res, rc.map()); });
-  server.get("/api/run/frame.jpg", [&rc](const httplib::Request&, httplib::Response& res) {
-    const auto jpg = rc.frameJpeg();
+  server.get("/api/run/frame.jpg", [&rc](const httplib::Request& req, httplib::Response& res) {
+    FrameOverlay ov;
+    ov.windows = queryInt(req, "windows", -1, -1, 1000);
+    ov.detections = queryInt(req, "detections", -1, -1, 1000);
+    const auto jpg = rc.frameJpeg(ov);
     if (jpg.empty()) return sendError(res, 404, "no camera frame yet");
     res.set_content(std::string(jpg.begin(), jpg.end()), "image/jpeg");
+  });
+  server.get("/api/run/series", [&rc](const httplib::Request& req, httplib::Response& res) {
+    sendJson(res, rc.series(queryInt(req, "tick", 0, 0, 1 << 30), queryInt(req, "obs", 0, 0, 1 << 30)));
+  });
+  server.get("/api/runs", [&rc](const httplib::Request&, httplib::Response& res) {
+    sendJson(res, {{"runs_dir", rc.options().runs_dir}, {"runs", listRuns(rc.options().runs_dir)}});
+  });
+  server.get(R"(/api/runs/([^/]+)/([^/]+))", [&rc](const httplib::Request& req,
+                                                   httplib::Response& res) {
+    const std::string id = req.matches[1], file = req.matches[2];
+    static const std::map<std::string, std::string> kinds = {
+        {"summary.json", "application/json"},
+        {"trajectory.png", "image/png"},
+        {"telemetry.csv", "text/plain; charset=utf-8"},
+        {"events.jsonl", "text/plain; charset=utf-8"}};
+    const auto kind = kinds.find(file);
+    if (kind == kinds.end())
+      throw InputError("run file: 'file' must be summary.json, trajectory.png, telemetry.csv or "
+                       "events.jsonl (not '" + file.substr(0, 60) + "')");
+    const fs::path p = runFolder(rc.options().runs_dir, id) / file;
+    std::ifstream in(p, std::ios::binary);
+    if (!in) return sendError(res, 404, "run '" + id + "' has no " + file + " (yet)");
+    std::ostringstream ss;
+    ss << in.rdbuf();
+    res.set_content(ss.str(), kind->second);
   });
   server.get("/api/run/worlds", [&rc](const httplib::Request&, httplib::Response& res) {
     const auto& o = rc.options();

@@ -16,6 +16,9 @@
 //   GET  /api/run/map     map geometry (odometry frame) and the trajectory so far
 //   POST /api/capture     {class, box?: [x, y, w, h]} -> <capture dir>/<class>/capture_<n>.jpg
 //   GET  /api/run/worlds  simulated worlds and sketches the page offers
+//   GET  /api/run/series?tick=N&obs=M  the run's time series from row N / M on (plots)
+//   GET  /api/runs        the run folders written so far (newest first), with their outcome
+//   GET  /api/runs/<id>/<file>  summary.json, trajectory.png, telemetry.csv or events.jsonl
 // Eigen-using headers (through nav) before httplib.h (server.h): a macro of httplib's breaks
 // Eigen's headers.
 #include "sketchnav/nav/executive.h"
@@ -68,6 +71,9 @@ struct RunHooks {
   std::function<std::unique_ptr<hw::Base>(std::unique_ptr<hw::Base>)> wrap_base;
   std::function<bool()> stop_requested;     // polled every tick: true -> stop and end the run
   std::function<void(const Json&)> on_map;  // map geometry, once before the run starts
+  /// The run folder to write (summary.json, trajectory.png, telemetry.csv, events.jsonl, as
+  /// `sketchnav run --out` does); "" = none (camera only, or no runs folder configured).
+  std::string out_dir;
 };
 
 /// Runs one navigation to the end (or until stop_requested()), returns its summary. Throws
@@ -88,6 +94,16 @@ struct RunApiOptions {
   /// The objectness windows perception examined in a frame, drawn on the live view; computed
   /// on demand (only while someone watches), optional.
   std::function<std::vector<cv::Rect>(const cv::Mat&)> propose_windows;
+  /// Where every run started from the page gets its folder (<runs_dir>/<UTC time>); "" = no
+  /// run folders.
+  std::string runs_dir;
+};
+
+/// What the live view draws over a frame: the `windows` first objectness windows (in the
+/// proposer's order, best first; -1 = all) and the `detections` best detections (-1 = all).
+struct FrameOverlay {
+  int windows = -1;
+  int detections = -1;
 };
 
 /// A landmark class name a capture may create: letters, digits, '_', '-', '.', ' ', no
@@ -117,7 +133,11 @@ class RunController {
   Json map() const;
   /// JPEG of the frame shown (the last one perception examined while it is recent, else the
   /// latest) with the objectness windows and the detections drawn; empty before any frame.
-  std::vector<unsigned char> frameJpeg() const;
+  std::vector<unsigned char> frameJpeg(const FrameOverlay& overlay = {}) const;
+  /// The run's time series from tick row `from_tick` and observation row `from_obs` on:
+  /// {ticks: [[t, v, w, servo_error|null, x, y, theta, section], ...], obs: [[t, inliers of
+  /// the best detection (0 = none), perception ms], ...], tick_rows, obs_rows}.
+  Json series(std::size_t from_tick, std::size_t from_obs) const;
   /// Saves the frame shown (or the box [x, y, w, h] of it, in its pixels) into
   /// <capture_dir>/<class>/capture_<n>.jpg. Returns {file, class, width, height}.
   Json capture(const std::string& class_name, const std::optional<cv::Rect>& box);
@@ -129,6 +149,7 @@ class RunController {
 
  private:
   void runThread(RunRequest request);
+  std::string newRunDir(const RunRequest& request) const;
   RunApiOptions opt_;
   std::shared_ptr<Live> live_;
   std::thread thread_;

@@ -43,29 +43,51 @@ function setStatus(text, kind = '') {
 }
 
 function snapshot() { return JSON.stringify({ ...state, W, H }); }
-function pushHistory() {
-  history.push(snapshot());
+let redoStack = [];
+// Records the state before an edit (`snap`, default now); a new edit drops what Redo had.
+function pushHistory(snap = snapshot()) {
+  history.push(snap);
   if (history.length > 200) history.shift();
-  $('undo').disabled = false;
+  redoStack = [];
+  updateHistoryButtons();
 }
-function undo() {
-  if (!history.length) return;
-  const prev = JSON.parse(history.pop());
-  setCanvasSize(prev.W, prev.H);
+function updateHistoryButtons() {
+  $('undo').disabled = history.length === 0;
+  $('redo').disabled = redoStack.length === 0;
+}
+function restore(snap) {
+  const prev = JSON.parse(snap);
+  if (prev.W !== W || prev.H !== H) setCanvasSize(prev.W, prev.H);
   delete prev.W; delete prev.H;
   Object.assign(state, prev);
   if (!state.landmarks.some((l) => l.id === selectedId)) selectedId = null;
-  $('undo').disabled = history.length === 0;
   changed();
+}
+function undo() {
+  if (!history.length) return;
+  redoStack.push(snapshot());
+  restore(history.pop());
+  updateHistoryButtons();
   setStatus('Undone.');
 }
+function redo() {
+  if (!redoStack.length) return;
+  history.push(snapshot());
+  restore(redoStack.pop());
+  updateHistoryButtons();
+  setStatus('Redone.');
+}
 
-function toCanvas(evt) {
+function toCanvasFree(evt) {
   const svg = $('canvas');
   const pt = svg.createSVGPoint();
   pt.x = evt.clientX; pt.y = evt.clientY;
   const p = pt.matrixTransform(svg.getScreenCTM().inverse());
-  return [clamp(p.x, 0, W), clamp(p.y, 0, H)];
+  return [p.x, p.y];
+}
+function toCanvas(evt) {
+  const p = toCanvasFree(evt);
+  return [clamp(p[0], 0, W), clamp(p[1], 0, H)];
 }
 
 function nextId() {
@@ -100,9 +122,9 @@ function toSketchJson() {
 
 function setCanvasSize(w, h) {
   W = w; H = h;
-  $('canvas').setAttribute('viewBox', `0 0 ${w} ${h}`);
   $('bg').setAttribute('width', w);
   $('bg').setAttribute('height', h);
+  fitView();
 }
 
 function fromSketchJson(j) {
@@ -121,6 +143,7 @@ function fromSketchJson(j) {
 
 // ---------- drawing ----------
 function render() {
+  renderBackground();
   renderPath();
   renderRoute();
   renderLandmarks();
@@ -183,8 +206,9 @@ function renderLandmarks() {
                     preserveAspectRatio: 'xMidYMid meet', opacity: 0.85, 'pointer-events': 'none' }, gg);
     const t = el('text', { x: l.x, y: l.y - 6 }, gg);
     t.textContent = `${l.id} · ${l.cls}`;
-    const d = el('text', { class: 'dist', x: l.x, y: l.y + l.h + 15 }, gg);
-    d.textContent = `${l.distance} m`;
+    const d = el('text', { class: 'dist' + (refChanged(l) ? ' changed' : ''), x: l.x, y: l.y + l.h + 15 }, gg);
+    const prev = previousOf(l.id);
+    d.textContent = prev ? `${l.distance} m from ${prev}` : `${l.distance} m`;
     // Labels stay inside the canvas: above the box unless that is off the top, below it
     // unless off the bottom, shifted left when they would run off the right edge.
     if (l.y - 6 < 14) t.setAttribute('y', Math.min(H - 4, l.y + l.h + 30));
@@ -234,6 +258,22 @@ function renderPanels() {
       `scale ${(route.scale_m_per_px * 100).toFixed(2)} m per 100 px; ` +
       `distance residual ${(route.scale_residual * 100).toFixed(0)} %`;
     for (const w of route.warnings) { const li = document.createElement('li'); li.textContent = w; warn.appendChild(li); }
+    for (const l of state.landmarks) {
+      if (!refChanged(l)) continue;
+      const li = document.createElement('li');
+      li.className = 'ref-warning';
+      li.dataset.id = l.id;
+      li.append(`${l.id}: its ${l.distance} m was given from ${l.ref}, but in route order it now follows ${previousOf(l.id)}: the distance now counts from ${previousOf(l.id)}. `);
+      const keep = document.createElement('button');
+      keep.textContent = `still right from ${previousOf(l.id)}`;
+      keep.title = 'The distance is right as it counts now';
+      keep.addEventListener('click', () => { pushHistory(); l.ref = previousOf(l.id); changed(); });
+      const fix = document.createElement('button');
+      fix.textContent = 'edit distance';
+      fix.addEventListener('click', () => editDistance(l.id));
+      li.append(keep, ' ', fix);
+      warn.appendChild(li);
+    }
     for (const s of route.sections) {
       const tr = body.insertRow();
       tr.insertCell().textContent = s.index;
@@ -269,9 +309,17 @@ function renderPanels() {
     inp.addEventListener('change', () => {
       const v = parseFloat(inp.value);
       if (!(v > 0 && v <= 1000)) { setStatus('A distance must be between 0.1 and 1000 m.', 'error'); inp.value = l.distance; return; }
-      pushHistory(); l.distance = v; changed();
+      pushHistory(); l.distance = v; l.ref = previousOf(l.id); delete l.refPending; changed();
     });
-    tr.insertCell().appendChild(inp);
+    const cell = tr.insertCell();
+    cell.className = 'dist-cell';
+    cell.appendChild(inp);
+    const from = document.createElement('span');
+    from.className = 'from' + (refChanged(l) ? ' changed' : '');
+    const prev = previousOf(l.id);
+    from.textContent = prev ? ` m from ${prev}` : ' m';
+    if (refChanged(l)) from.title = `given from ${l.ref}; in route order it now follows ${prev}`;
+    cell.appendChild(from);
     tr.addEventListener('click', () => { selectedId = l.id; render(); });
   }
   $('delete').disabled = !selectedId;
@@ -318,7 +366,7 @@ async function updateRoute() {
                                            body: JSON.stringify(toSketchJson()) });
     const j = await res.json();
     if (seq !== routeSeq) return;  // a newer edit is already being converted
-    if (res.ok) { route = j; routeError = ''; }
+    if (res.ok) { route = j; routeError = ''; adoptReferences(); }
     else { route = null; routeError = j.error || `error ${res.status}`; }
   } catch (e) {
     if (seq !== routeSeq) return;
@@ -328,10 +376,17 @@ async function updateRoute() {
 }
 
 // ---------- landmarks ----------
-function askDistance(title, initial) {
+function askDistance(title, initial, prev) {
   return new Promise((resolve) => {
     const dlg = $('dist-dialog');
     $('dist-title').textContent = title;
+    const hint = $('dist-hint');
+    if (prev) {
+      hint.replaceChildren('How far is this landmark from ', Object.assign(document.createElement('b'), { textContent: prev === 'start' ? 'the start' : prev }),
+        prev === 'start' ? ' (it is the first landmark in route order)?' : ', the previous landmark in route order? A rough guess is fine.');
+    } else {
+      hint.innerHTML = 'How far is this landmark from the <b>previous landmark</b> along the route (from the <b>start</b> for the first one)? A rough guess is fine.';
+    }
     $('dist-input').value = initial ?? '';
     dlg.returnValue = '';
     dlg.onclose = () => {
@@ -352,6 +407,7 @@ async function addLandmark() {
   const d = await askDistance(`Distance for ${lm.id} (${lm.cls})`, '');
   if (d === null) { setStatus('Add cancelled.'); return; }
   lm.distance = d;
+  lm.refPending = true;  // refers to what precedes it once the user puts it in its place
   pushHistory();
   state.landmarks.push(lm);
   selectedId = lm.id;
@@ -363,10 +419,13 @@ async function addLandmark() {
 async function editDistance(id) {
   const l = state.landmarks.find((x) => x.id === id);
   if (!l) return;
-  const d = await askDistance(`Distance for ${l.id} (${l.cls})`, l.distance);
+  const prev = previousOf(l.id);
+  const d = await askDistance(`Distance for ${l.id} (${l.cls})`, l.distance, prev);
   if (d === null) return;
   pushHistory();
   l.distance = d;
+  l.ref = previousOf(l.id);
+  delete l.refPending;
   changed();
 }
 
@@ -381,10 +440,19 @@ function deleteSelected() {
 
 // ---------- pointer interaction ----------
 function onPointerDown(evt) {
+  if (evt.button === 1) { startPan(evt); return; }  // the middle button pans in any tool
   if (evt.button !== 0) return;
   const p = toCanvas(evt);
   const target = evt.target;
   const lmNode = target.closest && target.closest('.lm');
+  if (tool === 'measure') { measureClick(toCanvasFree(evt)); return; }
+  if (tool === 'select' && !lmNode) {
+    // Dragging the empty canvas pans the view.
+    selectedId = null;
+    render();
+    startPan(evt);
+    return;
+  }
   if (tool === 'select') {
     if (lmNode) {
       const l = state.landmarks.find((x) => x.id === lmNode.dataset.id);
@@ -425,6 +493,13 @@ function onPointerDown(evt) {
 
 function onPointerMove(evt) {
   if (!drag) return;
+  if (drag.kind === 'pan') {
+    const k = drag.unit;
+    view.x = drag.view.x - (evt.clientX - drag.cx) / k;
+    view.y = drag.view.y - (evt.clientY - drag.cy) / k;
+    applyView();
+    return;
+  }
   const p = toCanvas(evt);
   if (drag.kind === 'path') {
     const last = state.path[state.path.length - 1];
@@ -462,11 +537,15 @@ function onPointerUp() {
       render();
       return;
     }
-    history.push(d.saved); $('undo').disabled = false;
+    pushHistory(d.saved);
     setStatus(`Path: ${state.path.length} points.`);
     changed();
+  } else if (d.kind === 'pan') {
+    $('canvas').classList.remove('panning');  // a view change: nothing to undo
   } else if (d.moved) {
-    history.push(d.saved); $('undo').disabled = false;
+    pushHistory(d.saved);
+    // A new landmark's distance refers to what precedes it where the user first puts it.
+    if (d.l.refPending) { delete d.l.refPending; d.l.ref = null; }
     changed();
   }
 }
@@ -477,8 +556,237 @@ function setTool(t) {
   $('canvas').setAttribute('class', 'mode-' + t);
   const tips = { select: 'Move: drag landmarks, drag the orange corner to resize, double-click to edit the distance.',
                  path: 'Draw path: press and drag from the start to the goal. Press near the end of the path to continue it.',
-                 start: 'Click where the robot starts.', goal: 'Click where the robot should arrive.' };
+                 start: 'Click where the robot starts.', goal: 'Click where the robot should arrive.',
+                 measure: 'Set scale: click two points on the floor plan whose distance you know.' };
+  measurePts = [];
+  $('layer-measure').replaceChildren();
   setStatus(tips[t]);
+}
+
+// ---------- the distance model: each distance counts from the previous landmark in route order
+// The landmark before `id` in route order ('start' for the first); null before a route exists.
+function previousOf(id) {
+  if (!route) return null;
+  const all = [];
+  for (const s of route.sections) for (const l of s.landmarks) all.push(l);
+  const me = all.find((l) => l.id === id);
+  if (!me) return null;
+  const prev = all.find((l) => l.order === me.order - 1);
+  return me.order === 0 || !prev ? 'start' : prev.id;
+}
+// True when route order now puts another landmark (or the start) before `l` than when its
+// distance was given: the same number then measures from somewhere else.
+function refChanged(l) {
+  if (!route || l.refPending || l.ref === undefined || l.ref === null) return false;
+  const prev = previousOf(l.id);
+  return prev !== null && prev !== l.ref;
+}
+// Landmarks whose reference is not known yet (opened from a file, just placed) take the
+// current one.
+function adoptReferences() {
+  for (const l of state.landmarks)
+    if (!l.refPending && (l.ref === undefined || l.ref === null)) l.ref = previousOf(l.id);
+}
+
+// ---------- view: zoom, pan, fit ----------
+const view = { x: 0, y: 0, w: 1000, h: 700 };
+function applyView() {
+  $('canvas').setAttribute('viewBox', `${view.x} ${view.y} ${view.w} ${view.h}`);
+  renderGrid();
+}
+function fitView() {
+  const m = 10;
+  Object.assign(view, { x: -m, y: -m, w: W + 2 * m, h: H + 2 * m });
+  applyView();
+}
+// Zooms by `f` (> 1 = in) about the canvas point `at` (default: the view's centre).
+function zoom(f, at) {
+  const c = at || [view.x + view.w / 2, view.y + view.h / 2];
+  const w = clamp(view.w / f, W / 20, W * 8);
+  const k = w / view.w;
+  Object.assign(view, { x: c[0] - (c[0] - view.x) * k, y: c[1] - (c[1] - view.y) * k, w, h: view.h * k });
+  applyView();
+}
+function screenUnit() { return $('canvas').getScreenCTM().a; }  // screen px per canvas px
+function startPan(evt) {
+  drag = { kind: 'pan', cx: evt.clientX, cy: evt.clientY, view: { ...view }, unit: screenUnit() };
+  $('canvas').setPointerCapture(evt.pointerId);
+  $('canvas').classList.add('panning');
+}
+
+// ---------- the world under the sketch: a simulated world's map or a floor-plan image ----------
+let worldMap = null;       // {name, geometry} (odometry frame: origin at the start, x ahead)
+let plan = null;           // {href, scale: m per canvas px | null, pts: [[x,y],[x,y]]}
+let measurePts = [];
+async function loadWorldMap(name) {
+  worldMap = null;
+  if (name) {
+    const { ok, j } = await api('api/worlds/' + encodeURIComponent(name) + '/map');
+    if (!ok) { setStatus('No map of ' + name + ': ' + j.error, 'error'); }
+    else worldMap = { name, geometry: j };
+  }
+  localStorage.setItem('sketchnav.editor.world', name);
+  render();
+}
+// The transform odometry frame -> canvas: as the robot reads the sketch (the start on the
+// world's start, the first section along its heading, at the scale the distances give) once
+// there is a route; before that the world fitted into the canvas.
+function worldToCanvasFn() {
+  const g = worldMap.geometry;
+  if (route && startPoint()) {
+    const a = route.start_heading_rad, c = Math.cos(a), s = Math.sin(a);
+    const f = (p) => routeToCanvas([c * p[0] - s * p[1] + route.start_m[0], s * p[0] + c * p[1] + route.start_m[1]]);
+    f.how = `placed as the robot reads the sketch: start on the world's start, first section along its heading, 1 m = ${(1 / route.scale_m_per_px).toFixed(1)} px (from your distances)`;
+    f.k = 1 / route.scale_m_per_px;
+    return f;
+  }
+  const pts = (g.floor || []).concat(...(g.walls || []).map((w) => [w.slice(0, 2), w.slice(2, 4)]));
+  if (!pts.length) pts.push([0, 0]);
+  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+  const x0 = Math.min(...xs), x1 = Math.max(...xs), y0 = Math.min(...ys), y1 = Math.max(...ys);
+  const k = 0.9 * Math.min(W / Math.max(x1 - x0, 1e-3), H / Math.max(y1 - y0, 1e-3));
+  const f = (p) => [W / 2 + (p[0] - (x0 + x1) / 2) * k, H / 2 - (p[1] - (y0 + y1) / 2) * k];
+  f.how = `fitted into the canvas until there is a route (then placed as the robot reads the sketch), 1 m = ${k.toFixed(1)} px`;
+  f.k = k;
+  return f;
+}
+function renderBackground() {
+  const lp = $('layer-plan'), lw = $('layer-world');
+  lp.replaceChildren();
+  lw.replaceChildren();
+  const notes = [];
+  if (plan) {
+    el('image', { href: plan.href, x: 0, y: 0, width: W, height: H, preserveAspectRatio: 'xMidYMid meet', opacity: 0.4, class: 'plan' }, lp);
+    notes.push(plan.scale ? `floor plan: 1 m = ${(1 / plan.scale).toFixed(1)} px` + (route ? `; your distances: 1 m = ${(1 / route.scale_m_per_px).toFixed(1)} px (${Math.round(Math.abs(plan.scale / route.scale_m_per_px - 1) * 100)} % apart)` : '') : 'floor plan without a scale: Set scale');
+    if (plan.pts && plan.pts.length === 2) {
+      el('line', { class: 'measure', x1: plan.pts[0][0], y1: plan.pts[0][1], x2: plan.pts[1][0], y2: plan.pts[1][1] }, lp);
+    }
+  }
+  if (worldMap && $('show-world').checked) {
+    const g = worldMap.geometry, f = worldToCanvasFn();
+    const gg = el('g', { class: 'world-map', opacity: 0.5 }, lw);
+    const pts = (a) => a.map((p) => f(p).join(',')).join(' ');
+    if (g.floor && g.floor.length) el('polygon', { class: 'w-floor', points: pts(g.floor) }, gg);
+    for (const o of g.obstacles || []) {
+      if (o.polygon) el('polygon', { class: 'w-obstacle', points: pts(o.polygon) }, gg);
+      else { const c = f([o.x, o.y]); el('circle', { class: 'w-obstacle', cx: c[0], cy: c[1], r: o.r * f.k }, gg); }
+    }
+    for (const w of g.walls || []) {
+      const a = f(w.slice(0, 2)), b = f(w.slice(2, 4));
+      el('line', { class: 'w-wall', x1: a[0], y1: a[1], x2: b[0], y2: b[1], 'stroke-width': Math.max(2, (w[4] || 0.1) * f.k) }, gg);
+    }
+    if (g.goal) { const c = f([g.goal.x, g.goal.y]); el('circle', { class: 'w-goal', cx: c[0], cy: c[1], r: Math.max(6, g.goal.r * f.k) }, gg); }
+    for (const l of g.world_landmarks || []) {
+      const c = f([l.x, l.y]);
+      el('rect', { class: 'w-lm', x: c[0] - 5, y: c[1] - 5, width: 10, height: 10 }, gg);
+      const t = el('text', { class: 'w-lm-label', x: c[0] + 7, y: c[1] - 6 }, gg);
+      t.textContent = `${l.id} ${l.class}`;
+    }
+    const st = f([0, 0]), ah = f([0.8, 0]);
+    el('line', { class: 'w-start', x1: st[0], y1: st[1], x2: ah[0], y2: ah[1] }, gg);
+    notes.push(`world ${worldMap.name} ${f.how}`);
+  }
+  $('bg-note').hidden = !notes.length;
+  $('bg-note').textContent = notes.join(' · ');
+  $('plan-scale').disabled = !plan;
+  $('plan-clear').disabled = !plan;
+  renderGrid();
+}
+// Metres per canvas px for the grid and the scale bar: the floor plan's when it has one, else
+// the distances'.
+function metricScale() {
+  if (plan && plan.scale) return { m: plan.scale, from: 'floor plan' };
+  if (route) return { m: route.scale_m_per_px, from: 'your distances' };
+  return null;
+}
+function renderGrid() {
+  const g = $('layer-grid');
+  if (!g) return;
+  g.replaceChildren();
+  const sc = metricScale(), bar = $('scale-bar');
+  const on = sc && $('show-grid').checked;
+  $('bg').setAttribute('fill', on ? '#fff' : 'url(#grid)');
+  if (!sc) { bar.hidden = true; return; }
+  const unit = screenUnit() || 1;  // screen px per canvas px
+  const pxPerM = unit / sc.m;      // screen px per metre
+  const step = [0.1, 0.2, 0.5, 1, 2, 5, 10, 20, 50, 100].find((m) => m * pxPerM >= 40) || 200;
+  const stepPx = step / sc.m;      // canvas px
+  const o = startPoint() || [0, 0];  // grid lines through the start
+  if (on) {
+    const x0 = Math.max(view.x, -W), x1 = Math.min(view.x + view.w, 2 * W), y0 = Math.max(view.y, -H), y1 = Math.min(view.y + view.h, 2 * H);
+    let d = '';
+    for (let x = o[0] + Math.ceil((x0 - o[0]) / stepPx) * stepPx; x <= x1; x += stepPx) d += `M${x.toFixed(1)} ${y0.toFixed(1)}V${y1.toFixed(1)}`;
+    for (let y = o[1] + Math.ceil((y0 - o[1]) / stepPx) * stepPx; y <= y1; y += stepPx) d += `M${x0.toFixed(1)} ${y.toFixed(1)}H${x1.toFixed(1)}`;
+    el('path', { class: 'metric-grid', d, 'data-step-m': step, 'data-step-px': stepPx }, g);
+  }
+  bar.hidden = false;
+  $('scale-bar-line').style.width = `${Math.round(step * pxPerM)}px`;
+  $('scale-bar-text').textContent = `${step} m (${sc.from})`;
+  bar.dataset.stepM = step;
+}
+function loadPlan(file) {
+  if (!file) return;
+  const r = new FileReader();
+  r.onload = () => {
+    plan = { href: r.result, scale: null, pts: null };
+    render();
+    setTool('measure');
+  };
+  r.readAsDataURL(file);
+}
+function measureClick(p) {
+  measurePts.push(p);
+  const g = $('layer-measure');
+  el('circle', { class: 'measure-pt', cx: p[0], cy: p[1], r: 5 }, g);
+  if (measurePts.length < 2) { setStatus('Set scale: now click the second point.'); return; }
+  const [a, b] = measurePts;
+  measurePts = [];
+  g.replaceChildren();
+  const px = Math.hypot(b[0] - a[0], b[1] - a[1]);
+  const ans = prompt('Distance between the two points, in metres:', '');
+  const m = parseFloat(ans);
+  if (!(m > 0) || px < 5) { setStatus('Scale not set (give a distance > 0 between two distinct points).', 'error'); setTool('select'); return; }
+  plan.scale = m / px;
+  plan.pts = [a, b];
+  setTool('select');
+  render();
+  setStatus(`Floor plan scale: ${m} m over ${px.toFixed(0)} px, 1 m = ${(px / m).toFixed(1)} px.`, 'ok');
+}
+
+// ---------- run this sketch ----------
+let sketchFiles = [];   // [{path, file, source}] from /api/run/worlds
+let currentFile = null; // {source: 'sketches'|'examples', file}
+async function loadWorlds() {
+  const { ok, j } = await api('api/run/worlds');
+  if (!ok) return;
+  sketchFiles = j.sketch_files || [];
+  const sel = $('world');
+  for (const w of j.worlds) sel.append(new Option(w, w));
+  const last = localStorage.getItem('sketchnav.editor.world');
+  if (last && j.worlds.includes(last)) { sel.value = last; loadWorldMap(last); }
+}
+async function runThisSketch() {
+  const world = $('world').value;
+  if (!world) { setStatus('Pick the world to run in (World, under the toolbar).', 'error'); $('world').focus(); return; }
+  let path = null;
+  if (dirty || !currentFile) {
+    if (!$('name').value.trim()) { setStatus('Type a file name: the sketch is saved before it runs.', 'error'); $('name').focus(); return; }
+    path = await save();
+    if (!path) return;
+  } else {
+    const dirFiles = await api('api/run/worlds');
+    if (dirFiles.ok) sketchFiles = dirFiles.j.sketch_files || [];
+    const want = currentFile.source === 'examples' ? 'example' : 'user';
+    const f = sketchFiles.find((x) => x.file === currentFile.file && x.source === want);
+    if (!f) { setStatus(`Cannot find ${currentFile.file} to run: save it first.`, 'error'); return; }
+    path = f.path;
+  }
+  const r = await api('api/run/start', { method: 'POST', headers: { 'Content-Type': 'application/json' },
+                                         body: JSON.stringify({ mode: 'sim', world, sketch: path, seed: 1 }) });
+  if (!r.ok) { setStatus('Not started: ' + r.j.error, 'error'); return; }
+  localStorage.setItem('sketchnav.run.world', world);
+  setStatus(`Started a simulated run of ${path} in ${world}.`, 'ok');
+  window.location.href = 'run.html';
 }
 
 // ---------- files ----------
@@ -515,6 +823,7 @@ async function openSketch(value) {
   pushHistory();
   fromSketchJson(j);
   const file = value.split('/').pop();
+  currentFile = { source: value.split('/')[0], file };
   $('name').value = value.startsWith('examples/') ? '' : file.replace(/\.sketch\.json$/, '');
   changed(false);
   dirty = false;
@@ -523,25 +832,27 @@ async function openSketch(value) {
 
 async function save() {
   const name = $('name').value.trim();
-  if (!name) { setStatus('Type a file name first.', 'error'); $('name').focus(); return; }
+  if (!name) { setStatus('Type a file name first.', 'error'); $('name').focus(); return null; }
   state.name = state.name || name;
   const body = JSON.stringify(toSketchJson());
   const url = 'api/sketches/' + encodeURIComponent(name);
   const file = name.endsWith('.sketch.json') ? name : name + '.sketch.json';
   let overwrite = '';
   if (savedFiles.includes(file)) {
-    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return; }
+    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return null; }
     overwrite = '?overwrite=1';
   }
   let r = await api(url + overwrite, { method: 'POST', headers: { 'Content-Type': 'application/json' }, body });
   if (r.status === 409) {  // saved meanwhile by someone else
-    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return; }
+    if (!confirm(`${file} exists. Overwrite it?`)) { setStatus('Not saved.'); return null; }
     r = await api(url + '?overwrite=1', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body });
   }
-  if (!r.ok) { setStatus('Not saved: ' + r.j.error, 'error'); return; }
+  if (!r.ok) { setStatus('Not saved: ' + r.j.error, 'error'); return null; }
   dirty = false;
+  currentFile = { source: 'sketches', file: r.j.saved };
   setStatus(`Saved ${r.j.path}`, 'ok');
   refreshFileList('sketches/' + r.j.saved);
+  return r.j.path;
 }
 
 function newSketch() {
@@ -551,6 +862,7 @@ function newSketch() {
   setCanvasSize(1000, 700);
   selectedId = null;
   $('name').value = '';
+  currentFile = null;
   changed();
   setStatus('New sketch.');
 }
@@ -592,6 +904,19 @@ function init() {
   document.querySelectorAll('.tool').forEach((b) => b.addEventListener('click', () => setTool(b.dataset.tool)));
   $('add').addEventListener('click', addLandmark);
   $('undo').addEventListener('click', undo);
+  $('redo').addEventListener('click', redo);
+  $('zoom-in').addEventListener('click', () => zoom(1.25));
+  $('zoom-out').addEventListener('click', () => zoom(0.8));
+  $('zoom-fit').addEventListener('click', fitView);
+  svg.addEventListener('wheel', (e) => { e.preventDefault(); zoom(e.deltaY < 0 ? 1.15 : 1 / 1.15, toCanvasFree(e)); }, { passive: false });
+  $('world').addEventListener('change', () => loadWorldMap($('world').value));
+  $('show-world').addEventListener('change', render);
+  $('show-grid').addEventListener('change', renderGrid);
+  $('plan-file').addEventListener('change', (e) => { loadPlan(e.target.files[0]); e.target.value = ''; });
+  $('plan-scale').addEventListener('click', () => setTool('measure'));
+  $('plan-clear').addEventListener('click', () => { plan = null; render(); });
+  $('run-sketch').addEventListener('click', runThisSketch);
+  new ResizeObserver(() => renderGrid()).observe(svg);
   $('delete').addEventListener('click', deleteSelected);
   $('clear-path').addEventListener('click', () => { if (!state.path.length) return; pushHistory(); state.path = []; changed(); });
   $('show-route').addEventListener('change', render);
@@ -603,7 +928,11 @@ function init() {
   $('name').addEventListener('change', () => { state.name = $('name').value.trim(); });
   document.addEventListener('keydown', (e) => {
     if (e.target.tagName === 'INPUT' || $('dist-dialog').open) return;
-    if ((e.ctrlKey || e.metaKey) && e.key === 'z') { e.preventDefault(); undo(); }
+    if ((e.ctrlKey || e.metaKey) && (e.key === 'y' || (e.shiftKey && (e.key === 'z' || e.key === 'Z')))) { e.preventDefault(); redo(); }
+    else if ((e.ctrlKey || e.metaKey) && e.key === 'z') { e.preventDefault(); undo(); }
+    else if (e.key === '+' || e.key === '=') zoom(1.25);
+    else if (e.key === '-') zoom(0.8);
+    else if (e.key === '0') fitView();
     else if ((e.ctrlKey || e.metaKey) && e.key === 's') { e.preventDefault(); save(); }
     else if (e.key === 'Delete' || e.key === 'Backspace') deleteSelected();
     else if (e.key === 'v') setTool('select');
@@ -612,11 +941,13 @@ function init() {
     else if (e.key === 'g') setTool('goal');
   });
   window.addEventListener('beforeunload', (e) => { if (dirty) { e.preventDefault(); e.returnValue = ''; } });
-  $('undo').disabled = true;
+  updateHistoryButtons();
+  fitView();
   setTool('select');
   render();
   loadClasses().then(() => { render(); setStatus('Pick a landmark class on the left and press Add.'); });
   refreshFileList();
+  loadWorlds();
 }
 
 init();

@@ -92,7 +92,9 @@ function clearCamera() {
 }
 async function start(req, what) {
   $('start').disabled = true;
-  clearCamera();  // neither the old frame nor the old capture box belong to this run
+  clearCamera();
+  resetSeries();
+  $('run-card').hidden = true;  // neither the old frame nor the old capture box belong to this run
   try {
     await api('POST', '/api/run/start', req);
     startError = null;
@@ -223,8 +225,135 @@ function render(s) {
   if (s.shown_seq > 0 && s.shown_seq !== frameSeq && !frameLoading && !dragFrom && !startError) {
     frameLoading = true;
     frameSeq = s.shown_seq;
-    $('camera-img').src = `/api/run/frame.jpg?seq=${s.shown_seq}`;
+    $('camera-img').src = frameUrl(s.shown_seq);
   }
+  renderProgress(s);
+  renderAttended(s);
+  renderCard(s);
+}
+
+// ---- camera overlay options -------------------------------------------------------------
+function frameUrl(seq) {
+  return `/api/run/frame.jpg?seq=${seq}&windows=${$('opt-windows').value}&detections=${$('opt-detections').value}`;
+}
+for (const id of ['opt-windows', 'opt-detections']) {
+  $(id).value = localStorage.getItem('sketchnav.run.' + id) ?? $(id).value;
+  $(id).addEventListener('change', () => {
+    localStorage.setItem('sketchnav.run.' + id, $(id).value);
+    // Redraw the frame shown with the new overlay.
+    if (frameSeq > 0 && !frameLoading) { frameLoading = true; $('camera-img').src = frameUrl(frameSeq) + '&t=' + Date.now(); }
+  });
+}
+
+// The attended landmark's database photo beside the live view.
+function renderAttended(s) {
+  const fig = $('attended');
+  const cls = s.active ? s.landmark_class : '';
+  if (!cls) { fig.hidden = true; return; }
+  const src = `/api/classes/${encodeURIComponent(cls)}/thumbnail`;
+  if ($('attended-img').getAttribute('src') !== src) $('attended-img').src = src;
+  $('attended-label').textContent = `attending ${s.landmark} · ${cls}`;
+  fig.hidden = false;
+}
+
+// ---- progress and the end-of-run card ---------------------------------------------------
+function renderProgress(s) {
+  const p = s.progress || {};
+  const fill = $('progress-fill'), txt = $('progress-text');
+  if (typeof p.fraction !== 'number') {
+    fill.style.width = '0';
+    txt.textContent = s.active ? 'starting…' : 'no route yet';
+    return;
+  }
+  fill.style.width = `${(p.fraction * 100).toFixed(1)}%`;
+  const parts = [`${Math.round(p.fraction * 100)} % of the route`, `${fmt(p.remaining_m, 1)} m left`];
+  if (typeof p.real_time_factor === 'number') parts.push(`×${fmt(p.real_time_factor)} real time`);
+  txt.textContent = parts.join(' · ');
+}
+
+const RUN_FILES = ['summary.json', 'trajectory.png', 'telemetry.csv', 'events.jsonl'];
+function runLinks(id, files) {
+  const span = document.createElement('span');
+  span.className = 'run-links';
+  for (const f of files) {
+    const a = document.createElement('a');
+    a.href = `/api/runs/${encodeURIComponent(id)}/${f}`;
+    a.target = '_blank';
+    a.textContent = f;
+    span.append(a);
+  }
+  return span;
+}
+let cardKey = '';
+function renderCard(s) {
+  const card = $('run-card');
+  const sum = s.summary;
+  if (s.active || !sum || typeof sum !== 'object' || s.status === 'idle') {
+    if (s.active) { card.hidden = true; cardKey = ''; }
+    return;
+  }
+  const key = s.run_id + s.status + (sum.reason || '');
+  if (key === cardKey) return;
+  cardKey = key;
+  const outcome = s.status === 'stopped' ? 'stopped' : s.status === 'error' ? 'error' : sum.success ? 'succeeded' : 'failed';
+  const rows = [];
+  const m = (v, d = 2) => (typeof v === 'number' ? v.toFixed(d) + ' m' : '–');
+  if (typeof sum.time_s === 'number') rows.push(['time', `${sum.time_s.toFixed(1)} s` + (typeof sum.wall_time_s === 'number' ? ` (${sum.wall_time_s.toFixed(1)} s wall)` : '')]);
+  if ('path_length_m' in sum) rows.push(['path length', m(sum.path_length_m)]);
+  if ('distance_to_goal_m' in sum) rows.push(['distance to goal', m(sum.distance_to_goal_m)]);
+  if ('landmarks_expected' in sum) rows.push(['landmarks', `${(sum.landmarks_recognised || []).length}/${sum.landmarks_expected} recognised`]);
+  if (sum.deviation_m) rows.push(['deviation from the sketch', `${m(sum.deviation_m.mean)} mean, ${m(sum.deviation_m.max)} max`]);
+  if (typeof sum.real_time_factor === 'number') rows.push(['real-time factor', `×${sum.real_time_factor.toFixed(2)}`]);
+  card.replaceChildren();
+  card.className = 'run-card ' + outcome;
+  const h = document.createElement('div');
+  h.className = 'card-head';
+  h.textContent = outcome;
+  const r = document.createElement('div');
+  r.className = 'card-reason';
+  r.textContent = s.status === 'stopped' ? 'stopped by user' : (sum.reason || s.reason || '');
+  card.append(h, r);
+  const dl = document.createElement('dl');
+  for (const [k, v] of rows) {
+    const dt = document.createElement('dt'); dt.textContent = k;
+    const dd = document.createElement('dd'); dd.textContent = v;
+    dl.append(dt, dd);
+  }
+  card.append(dl);
+  if (s.run_id) {
+    const files = document.createElement('div');
+    files.className = 'card-files';
+    files.append('Run folder: ', Object.assign(document.createElement('code'), { textContent: s.run_dir, title: s.run_dir }), document.createElement('br'));
+    files.append(runLinks(s.run_id, sum.error ? ['summary.json'] : RUN_FILES));
+    card.append(files);
+    if (!sum.error) {
+      const a = Object.assign(document.createElement('a'), { href: `/api/runs/${encodeURIComponent(s.run_id)}/trajectory.png`, target: '_blank' });
+      a.append(Object.assign(document.createElement('img'), { className: 'card-traj', alt: 'trajectory', src: `/api/runs/${encodeURIComponent(s.run_id)}/trajectory.png?k=${encodeURIComponent(key)}` }));
+      card.append(a);
+    }
+  }
+  card.hidden = false;
+  refreshRuns();
+}
+
+async function refreshRuns() {
+  try {
+    const r = await api('GET', '/api/runs');
+    $('runs-dir').textContent = r.runs_dir || 'the runs folder';
+    $('runs').replaceChildren(...r.runs.slice(0, 6).map((x) => {
+      const li = document.createElement('li');
+      const head = document.createElement('div');
+      const ok = document.createElement('b');
+      ok.className = x.success ? 'ok' : 'bad';
+      ok.textContent = x.success === undefined ? '…' : x.success ? '✓' : '✗';
+      head.append(ok, ' ', Object.assign(document.createElement('span'), { className: 'run-id', textContent: x.id, title: x.reason || '' }));
+      li.append(head);
+      if (x.reason) li.append(Object.assign(document.createElement('div'), { className: 'run-reason', textContent: x.reason }));
+      li.append(runLinks(x.id, x.files));
+      return li;
+    }));
+    if (!r.runs.length) $('runs').replaceChildren(Object.assign(document.createElement('li'), { className: 'hint', textContent: 'none yet' }));
+  } catch (_) { /* the state poll reports a lost server */ }
 }
 
 $('camera-img').addEventListener('load', () => {
@@ -311,8 +440,152 @@ async function pollMap() {
     } else {
       robot.setAttribute('points', '');
     }
+    drawGhost();
   } catch (_) { /* the state poll reports a lost server */ }
 }
+
+// The robot where it was at the scrubbed time (hollow), while scrubbing back.
+function drawGhost() {
+  const svg = $('map');
+  let g = $('map-ghost');
+  if (!g) g = el('polygon', { id: 'map-ghost', class: 'ghost', points: '', 'vector-effect': 'non-scaling-stroke' }, svg);
+  const row = scrubT === null ? null : tickAt(scrubT);
+  if (!row) { g.setAttribute('points', ''); return; }
+  const u = Number(svg.dataset.unit) * 2.2, x = row[4], y = row[5], a = row[6];
+  const c = Math.cos(a), s = Math.sin(a);
+  const pts = [[1.4, 0], [-0.8, 0.8], [-0.8, -0.8]].map(([px, py]) => [x + u * (c * px - s * py), y + u * (s * px + c * py)]);
+  g.setAttribute('points', pts.map(P).join(' '));
+}
+
+// ---- plots: ω, v, servo error, inliers, perception ms over the run ----------------------
+const series = { ticks: [], obs: [] };
+let scrubT = null;  // null: follow the run; else the time shown [s]
+function resetSeries() { series.ticks = []; series.obs = []; scrubT = null; drawPlots(); }
+async function pollSeries() {
+  try {
+    const r = await api('GET', `/api/run/series?tick=${series.ticks.length}&obs=${series.obs.length}`);
+    if (r.tick_rows < series.ticks.length || r.obs_rows < series.obs.length) { resetSeries(); return; }
+    series.ticks.push(...r.ticks);
+    series.obs.push(...r.obs);
+    if (r.ticks.length || r.obs.length) drawPlots();
+  } catch (_) { /* the state poll reports a lost server */ }
+}
+setInterval(pollSeries, 500);
+
+function tickAt(t) {
+  const a = series.ticks;
+  if (!a.length) return null;
+  let lo = 0, hi = a.length - 1;
+  while (lo < hi) { const mid = (lo + hi + 1) >> 1; if (a[mid][0] <= t) lo = mid; else hi = mid - 1; }
+  return a[lo];
+}
+function obsAt(t) {
+  const a = series.obs;
+  let best = null;
+  for (const o of a) { if (o[0] <= t) best = o; else break; }
+  return best;
+}
+const PLOTS = [
+  { name: 'ω', unit: 'rad/s', color: '#2f6fde', get: () => series.ticks.map((r) => [r[0], r[2]]), sym: true },
+  { name: 'v', unit: 'm/s', color: '#1f9d55', get: () => series.ticks.map((r) => [r[0], r[1]]) },
+  { name: 'x_t − x_d', unit: '', color: '#d2691e', get: () => series.ticks.map((r) => [r[0], r[3]]), sym: true },
+  { name: 'inliers', unit: '', color: '#7b3fbf', get: () => series.obs.map((r) => [r[0], r[1]]), dots: true },
+  { name: 'perception', unit: 'ms', color: '#9b5b00', get: () => series.obs.map((r) => [r[0], r[2]]), dots: true },
+];
+function drawPlots() {
+  const cv = $('plots');
+  const dpr = window.devicePixelRatio || 1;
+  const w = cv.clientWidth, h = cv.clientHeight;
+  if (!w || !h) return;
+  if (cv.width !== Math.round(w * dpr) || cv.height !== Math.round(h * dpr)) { cv.width = Math.round(w * dpr); cv.height = Math.round(h * dpr); }
+  const ctx = cv.getContext('2d');
+  ctx.setTransform(dpr, 0, 0, dpr, 0, 0);
+  ctx.clearRect(0, 0, w, h);
+  ctx.font = '11px system-ui, sans-serif';
+  const left = 92, right = 8, axis = 14, n = PLOTS.length;
+  const stripH = (h - axis) / n;
+  const first = (a) => (a.length ? a[0][0] : Infinity), last = (a) => (a.length ? a[a.length - 1][0] : -Infinity);
+  const t0 = Number.isFinite(Math.min(first(series.ticks), first(series.obs))) ? Math.min(first(series.ticks), first(series.obs)) : 0;
+  const t1 = Math.max(t0 + 1, last(series.ticks), last(series.obs));
+  const X = (t) => left + ((t - t0) / (t1 - t0)) * (w - left - right);
+  const cursor = scrubT === null ? t1 : scrubT;
+  PLOTS.forEach((p, i) => {
+    const y0 = i * stripH, pts = p.get().filter((q) => q[1] !== null && Number.isFinite(q[1]));
+    ctx.fillStyle = i % 2 ? '#fafbfd' : '#f3f5f9';
+    ctx.fillRect(left, y0, w - left - right, stripH);
+    let lo = 0, hi = 0;
+    for (const q of pts) { lo = Math.min(lo, q[1]); hi = Math.max(hi, q[1]); }
+    if (p.sym) { const m = Math.max(Math.abs(lo), Math.abs(hi), 1e-3); lo = -m; hi = m; }
+    if (hi - lo < 1e-6) hi = lo + 1;
+    const Y = (v) => y0 + stripH - 3 - ((v - lo) / (hi - lo)) * (stripH - 6);
+    if (lo < 0 && hi > 0) { ctx.strokeStyle = '#cfd5df'; ctx.beginPath(); ctx.moveTo(left, Y(0)); ctx.lineTo(w - right, Y(0)); ctx.stroke(); }
+    ctx.strokeStyle = p.color; ctx.fillStyle = p.color; ctx.lineWidth = 1.4;
+    if (p.dots) {
+      for (const q of pts) ctx.fillRect(X(q[0]) - 1.2, Y(q[1]) - 1.2, 2.4, 2.4);
+    } else {
+      ctx.beginPath();
+      let pen = false, lastT = -1e9;
+      for (const q of p.get()) {
+        const ok = q[1] !== null && Number.isFinite(q[1]);
+        if (!ok || q[0] - lastT > 0.5) pen = false;  // gaps (no servoing) stay gaps
+        if (ok) { if (pen) ctx.lineTo(X(q[0]), Y(q[1])); else ctx.moveTo(X(q[0]), Y(q[1])); pen = true; lastT = q[0]; }
+      }
+      ctx.stroke();
+    }
+    // Label with the value at the cursor.
+    const at = i < 3 ? tickAt(cursor) : obsAt(cursor);
+    const v = at ? at[i < 3 ? [2, 1, 3][i] : [1, 2][i - 3]] : null;
+    ctx.fillStyle = '#1d2330';
+    ctx.fillText(`${p.name}${p.unit ? ' [' + p.unit + ']' : ''}`, 4, y0 + 13);
+    ctx.fillStyle = p.color;
+    ctx.font = '600 12px system-ui, sans-serif';
+    ctx.fillText(typeof v === 'number' ? v.toFixed(i >= 3 ? 0 : 2) : '–', 4, y0 + 28);
+    ctx.font = '11px system-ui, sans-serif';
+    ctx.fillStyle = '#8a93a3';
+    ctx.fillText(`${+hi.toPrecision(2)}`, left + 3, y0 + 11);
+    ctx.fillText(`${+lo.toPrecision(2)}`, left + 3, y0 + stripH - 4);
+  });
+  // Time axis.
+  ctx.fillStyle = '#5a6475';
+  const step = [1, 2, 5, 10, 20, 30, 60, 120, 300].find((s) => (t1 - t0) / s <= 8) || 600;
+  for (let t = Math.ceil(t0 / step) * step; t <= t1; t += step) {
+    ctx.fillRect(X(t), h - axis, 1, 4);
+    ctx.fillText(`${t}s`, X(t) - 6, h - 2);
+  }
+  // The cursor: the scrubbed time (or the end while following the run).
+  if (series.ticks.length) {
+    ctx.strokeStyle = scrubT === null ? 'rgba(29,35,48,.25)' : '#c62828';
+    ctx.lineWidth = scrubT === null ? 1 : 1.5;
+    ctx.beginPath(); ctx.moveTo(X(cursor), 0); ctx.lineTo(X(cursor), h - axis); ctx.stroke();
+  }
+  const sc = $('scrub');
+  sc.disabled = !series.ticks.length;
+  $('scrub-live').disabled = scrubT === null;
+  if (scrubT === null) sc.value = sc.max;
+  plotRange = [t0, t1];
+  const row = tickAt(cursor);
+  $('scrub-readout').textContent = scrubT === null ? (series.ticks.length ? 'following the run' : '') :
+    `t ${cursor.toFixed(1)} s` + (row ? ` · section ${row[7] + 1} · x ${row[4].toFixed(2)} y ${row[5].toFixed(2)}` : '');
+}
+let plotRange = [0, 1];
+$('scrub').addEventListener('input', () => {
+  const sc = $('scrub'), f = Number(sc.value) / Number(sc.max);
+  scrubT = f >= 1 ? null : plotRange[0] + f * (plotRange[1] - plotRange[0]);
+  drawPlots();
+  drawGhost();
+});
+$('scrub-live').addEventListener('click', () => { scrubT = null; drawPlots(); drawGhost(); });
+$('plots').addEventListener('pointerdown', (e) => {
+  // A click on the plots scrubs to that time.
+  const r = $('plots').getBoundingClientRect(), left = 92, right = 8;
+  const f = (e.clientX - r.left - left) / (r.width - left - right);
+  if (f < 0 || !series.ticks.length) return;
+  scrubT = f >= 1 ? null : plotRange[0] + f * (plotRange[1] - plotRange[0]);
+  $('scrub').value = Math.round(Math.min(1, f) * Number($('scrub').max));
+  drawPlots();
+  drawGhost();
+});
+new ResizeObserver(drawPlots).observe($('plots'));
 setInterval(pollMap, 500);
 
 // ---- capture: a box dragged on the camera image, in the frame's own pixels -----------------
@@ -390,5 +663,6 @@ $('capture-frame').addEventListener('click', () => capture(false));
 $('capture-box').addEventListener('click', () => capture(true));
 
 loadChoices();
+refreshRuns();
 poll(true);
 pollMap();

@@ -35,3 +35,15 @@ if(SKETCHNAV_NODE)
   set_tests_properties(browser_ui_bugs PROPERTIES TIMEOUT 180 LABELS "ui;browser"
     SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
 endif()
+if(SKETCHNAV_NODE)
+  # What a user expects (issue 29): the world under the sketch, the distance model, Run this
+  # sketch, the run's record, plots, overlay options, tablets (features.test.mjs). Real time:
+  # one simulated corridor run of about a minute.
+  add_test(NAME browser_ui_features
+    COMMAND ${SKETCHNAV_NODE} ${_browser_dir}/features.test.mjs
+      --sketchnav $<TARGET_FILE:sketchnav>
+      --out ${CMAKE_CURRENT_BINARY_DIR}/browser-features
+      --model-cache ${PROJECT_BINARY_DIR}/model-cache)
+  set_tests_properties(browser_ui_features PROPERTIES TIMEOUT 400 LABELS "ui;browser"
+    SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
+endif()
