@@ -11,7 +11,7 @@
 #include "cli.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
-#include "sketchnav/hw/base_server.h"
+#include "sketchnav/drivers/base_server.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world.h"
 
@@ -50,7 +50,7 @@ int runBaseEmulator(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("seconds", "exit after T seconds of wall time (0: until Ctrl-C / SIGTERM)", "0");
   if (!args.parse(argv)) return 0;
 
-  hw::BaseServerParams p;
+  drivers::BaseServerParams p;
   applyConfig(p, g.config, "base_server");
   {
     sim::SimParams sp;  // --world none takes them too (and ignores them), as before
@@ -72,12 +72,12 @@ int runBaseEmulator(const std::vector<std::string>& argv, GlobalOptions& g) {
   // time by this loop; or a bare unicycle model with no world.
   hw::SteadyClock wall;
   std::unique_ptr<sim::Simulator> simulator;
-  std::unique_ptr<hw::UnicycleBase> unicycle;
+  std::unique_ptr<drivers::UnicycleBase> unicycle;
   hw::Base* vehicle = nullptr;
   hw::RangeSensor* sonar = nullptr;
   const std::string world = args.get("world");
   if (world == "none") {
-    unicycle = std::make_unique<hw::UnicycleBase>(wall);
+    unicycle = std::make_unique<drivers::UnicycleBase>(wall);
     vehicle = unicycle.get();
   } else {
     sim::SimParams sp;
@@ -88,7 +88,7 @@ int runBaseEmulator(const std::vector<std::string>& argv, GlobalOptions& g) {
     sonar = &simulator->sonar();
   }
 
-  hw::BaseServer server(*vehicle, sonar, wall, p);
+  drivers::BaseServer server(*vehicle, sonar, wall, p);
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   // The port on stdout, alone on its line, so scripts and tests started with --port 0 find it.

@@ -6,8 +6,9 @@
 
 #include "cli.h"
 #include "sketchnav/core/error.h"
-#include "sketchnav/hw/aravis_camera.h"
-#include "sketchnav/hw/dani_base.h"
+#include "sketchnav/drivers/aravis_camera.h"
+#include "sketchnav/drivers/dani_base.h"
+#include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/sim/register.h"
 
@@ -55,7 +56,7 @@ int runProbe(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("frames", "stop after N frames / messages (default 100 unless --seconds)")
       .option("seconds", "stop after T seconds of wall time (default 10)");
   if (!args.parse(argv)) return 0;
-  hw::registerBuiltinDrivers();
+  drivers::registerDrivers();
   sim::registerDrivers();
   const std::string uri = args.positional().front();
   const std::string kind = args.has("kind") ? args.get("kind") : kindOf(uri);
@@ -95,14 +96,14 @@ int runProbe(const std::vector<std::string>& argv, GlobalOptions& g) {
       report["width"] = k.width;
       report["height"] = k.height;
       // A live camera knows when a frame reached the host; otherwise report the wait.
-      const auto* gige = dynamic_cast<const hw::AravisCamera*>(cam.get());
+      const auto* gige = dynamic_cast<const drivers::AravisCamera*>(cam.get());
       if (gige && gige->meanLatencyMs() >= 0)
         report["latency_ms"] = gige->meanLatencyMs();
       else if (got.n > 0)
         report["latency_ms"] = 1000.0 * latency_sum / static_cast<double>(got.n);
     } else if (kind == "base") {
       auto base = hw::Registry::instance().createBase(uri, ctx);
-      auto* dani = dynamic_cast<hw::DaniBase*>(base.get());
+      auto* dani = dynamic_cast<drivers::DaniBase*>(base.get());
       // Count odometry messages as they arrive (the base streams them on its own).
       std::uint64_t seen = base->stats().received;
       double rtt_sum = 0;
@@ -128,7 +129,7 @@ int runProbe(const std::vector<std::string>& argv, GlobalOptions& g) {
       report["ok"] = base->ok();
       if (dani) {
         const auto st = dani->status();
-        report["base_state"] = hw::proto::toString(st.base_state);
+        report["base_state"] = drivers::proto::toString(st.base_state);
         report["link_faults"] = st.faults;
         if (rtt_n > 0) report["latency_ms"] = 0.5 * rtt_sum / rtt_n;  // one way: half the RTT
         report["rtt_ms"] = rtt_n > 0 ? Json(rtt_sum / rtt_n) : Json(nullptr);

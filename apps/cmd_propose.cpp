@@ -19,7 +19,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
-#include "sketchnav/hw/image_file.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/landmarks/baselines.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/voc.h"
@@ -181,7 +181,7 @@ int runEval(const Args& args, GlobalOptions& g, const ObjectnessParams& params) 
 int runImage(const Args& args, GlobalOptions& g, const ObjectnessParams& params) {
   const std::string path = args.positional().front();
   // Regular files only (a FIFO would block), the header's pixel count bounded before decoding.
-  const cv::Mat img = hw::readImageFile(path, "sketchnav propose: image");
+  const cv::Mat img = readImageFile(path, "sketchnav propose: image");
   const int n = args.getInt("windows");
   if (n <= 0) throw InputError("sketchnav propose: --windows must be a positive count");
   const int draw = std::min(n, args.getInt("draw"));

@@ -16,7 +16,7 @@
 #include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
-#include "sketchnav/hw/image_file.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
@@ -244,7 +244,7 @@ int evaluate(const Runner& runner, const std::string& dir, double index_ms, Glob
         std::cerr << "\rrecognise: " << done << "/" << total << std::flush;
       cv::Mat img;
       try {
-        img = hw::readImageFile(path, "image");
+        img = readImageFile(path, "image");
       } catch (const InputError& e) {
         log::warn("recognise", "skipping unreadable image", {{"file", path}, {"error", e.what()}});
         ++failed;
@@ -445,7 +445,7 @@ int runRecognise(const std::vector<std::string>& argv, GlobalOptions& g) {
     // Regular files only (a FIFO would block), the header's pixel count bounded before decoding.
     cv::Mat img;
     try {
-      img = runner.prepare(hw::readImageFile(path, "sketchnav recognise: image"));
+      img = runner.prepare(readImageFile(path, "sketchnav recognise: image"));
       if (img.empty())
         throw InputError("sketchnav recognise: image '" + path + "': empty after resizing");
     } catch (const InputError& e) {

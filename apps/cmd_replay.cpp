@@ -23,7 +23,9 @@
 #include "perception_bench.h"
 #include "scenario.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/landmarks/recognition.h"
@@ -44,16 +46,12 @@ class FrameSource {
     hfov_ = hfov_deg * M_PI / 180.0;
     if (fs::is_directory(spec)) {
       for (const auto& e : fs::directory_iterator(spec)) {
-        std::string ext = e.path().extension().string();
-        std::transform(ext.begin(), ext.end(), ext.begin(), ::tolower);
-        if (ext == ".png" || ext == ".jpg" || ext == ".jpeg" || ext == ".pgm" || ext == ".ppm" ||
-            ext == ".bmp" || ext == ".tif" || ext == ".tiff")
-          files_.push_back(e.path().string());
+        if (isImageFileName(e.path().string())) files_.push_back(e.path().string());
       }
       std::sort(files_.begin(), files_.end());
       if (files_.empty()) throw InputError("--frames " + spec + ": no images in the folder");
     } else if (spec.find("://") != std::string::npos) {
-      hw::registerBuiltinDrivers();
+      drivers::registerDrivers();
       sim::registerDrivers();
       hw::DeviceContext ctx;
       ctx.config = cfg;
@@ -71,8 +69,7 @@ class FrameSource {
     if (!files_.empty()) {
       if (index_ >= files_.size()) return false;
       name = fs::path(files_[index_]).filename().string();
-      img = cv::imread(files_[index_++], cv::IMREAD_COLOR);  // grey files come as 3 channels
-      if (img.empty()) throw InputError(name + ": cannot decode image");
+      img = readImageFile(files_[index_++], "--frames image");  // grey files come as 3 channels
     } else if (camera_) {
       hw::Frame f;
       for (;;) {
@@ -280,8 +277,12 @@ Json photoCeiling(const landmarks::LandmarkModel& model, const nav::PerceptionPa
     if (s.absent) continue;
     if (s.photo.empty()) return nullptr;
     if (recognised.count(s.photo)) continue;
-    const cv::Mat img = cv::imread((fs::path(data_dir) / s.photo).string(), cv::IMREAD_COLOR);
-    if (img.empty()) return nullptr;
+    cv::Mat img;
+    try {
+      img = readImageFile((fs::path(data_dir) / s.photo).string(), "photo");
+    } catch (const InputError&) {
+      return nullptr;
+    }
     const auto r = landmarks::recognise(model, img, {}, 1, pp.recognition);
     recognised[s.photo] = !r.empty() && !r[0].rejected && r[0].class_name == s.shown;
   }

@@ -15,6 +15,7 @@
 #include "sketchnav/core/input_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/hw/pose.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world.h"
@@ -212,7 +213,7 @@ int runDrive(const std::vector<std::string>& argv, GlobalOptions& g) {
   std::vector<hw::Pose2D> truth, odom_world;
   for (const auto& s : traj) {
     truth.push_back(s.truth);
-    odom_world.push_back(sim::composePose(sim.world().start, s.odom));
+    odom_world.push_back(hw::composePose(sim.world().start, s.odom));
   }
   canvas.drawPoses(odom_world, cv::Scalar(200, 120, 0), true, 1);
   canvas.drawPoses(truth, cv::Scalar(0, 0, 0), true, 2);

@@ -24,6 +24,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/sim/register.h"
 // clang-format on
@@ -153,7 +154,7 @@ Json worldGeometry(const std::string& world) {
 // "Camera only": frames for the live view and captures (e.g. building a landmark set with the
 // robot's camera, or a webcam: video://0), nothing else opened, nothing driven.
 Json cameraOnly(const ui::RunRequest& rq, const ui::RunHooks& h) {
-  hw::registerBuiltinDrivers();
+  drivers::registerDrivers();
   sim::registerDrivers();
   hw::DeviceContext ctx;
   ctx.clock = std::make_shared<hw::SteadyClock>();

@@ -7,7 +7,7 @@ target_include_directories(sketchnav_runharness PUBLIC ${CMAKE_CURRENT_SOURCE_DI
 # sim and mapsketch are public too: RunSettings (run_harness.h) holds their Params.
 target_link_libraries(sketchnav_runharness PUBLIC sketchnav::core sketchnav::hw sketchnav::nav
   sketchnav::sim sketchnav::mapsketch
-  PRIVATE sketchnav::landmarks opencv_imgproc
+  PRIVATE sketchnav::drivers sketchnav::landmarks opencv_imgproc
   opencv_imgcodecs)
 target_compile_options(sketchnav_runharness PRIVATE -Wall -Wextra -Wno-unused-parameter)
 target_link_libraries(sketchnav PRIVATE sketchnav_runharness)

@@ -16,6 +16,7 @@
 
 #include "plot.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 
 namespace sketchnav::app::bench {
 namespace fs = std::filesystem;
@@ -115,9 +116,7 @@ std::string brand(const std::string& cls) {
 }
 
 cv::Mat readImage(const std::string& path) {
-  cv::Mat m = cv::imread(path, cv::IMREAD_COLOR);
-  if (m.empty()) throw InputError(path + ": cannot decode image");
-  return m;
+  return readImageFile(path, "image");
 }
 
 // A catalogue photo is the product on white: crop to the non-white bounding box (+3 %), so

@@ -16,11 +16,15 @@
 #include <set>
 #include <sstream>
 
+#include "sketchnav/core/angles.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/hash.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
-#include "sketchnav/hw/rawlog.h"
-#include "sketchnav/hw/recording.h"
+#include "sketchnav/drivers/rawlog.h"
+#include "sketchnav/drivers/recording.h"
+#include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/landmarks/photo_hash.h"
@@ -47,11 +51,8 @@ std::string modelCachePath(const std::string& landmark_dir, const std::string& c
       dir = (fs::temp_directory_path() / "sketchnav-cache").string();
   }
   // FNV-1a of the landmark set's fingerprint (paths + sizes): a changed set gets a new file.
-  std::uint64_t h = 1469598103934665603ull;
-  for (unsigned char c : landmarks::landmarkSetFingerprint(landmark_dir)) {
-    h ^= c;
-    h *= 1099511628211ull;
-  }
+  const std::string fingerprint = landmarks::landmarkSetFingerprint(landmark_dir);
+  const std::uint64_t h = fnv1a(fingerprint.data(), fingerprint.size());
   std::ostringstream name;
   // The format version is in the name too: builds of different versions sharing one cache
   // directory would otherwise keep retraining over each other's file.
@@ -76,8 +77,7 @@ std::vector<TrainingTexture> trainingTextures(const sim::World& w,
   for (const auto& l : w.landmarks)
     for (const std::string& tex : {l.texture, l.back_texture}) {
       if (tex.empty() || !seen.insert(tex).second) continue;
-      cv::Mat img = cv::imread(tex, cv::IMREAD_COLOR);
-      if (img.empty()) throw InputError("texture '" + tex + "' cannot be read as an image");
+      cv::Mat img = readImageFile(tex, "texture");
       files.push_back(tex);
       images.push_back(std::move(img));
     }
@@ -394,7 +394,7 @@ RunVerdict judgeSimulatedRun(bool executive_ok, const std::string& executive_rea
 
 Json runNavigation(const RunOptions& o) {
   using wall = std::chrono::steady_clock;
-  hw::registerBuiltinDrivers();
+  drivers::registerDrivers();
   sim::registerDrivers();
   const bool replay = !o.replay.empty();
   if (replay && (!o.robot.empty() || !o.camera.empty() || !o.laser.empty() || !o.sonar.empty()))
@@ -463,11 +463,11 @@ Json runNavigation(const RunOptions& o) {
   if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
   o.config.requireAllUsed();
   if (!o.record.empty()) {
-    auto rec = std::make_shared<hw::RawlogRecorder>(o.record);
-    camera = hw::recordCamera(std::move(camera), rec);
-    base = hw::recordBase(std::move(base), rec, ctx.clock);
-    if (laser) laser = hw::recordRange(std::move(laser), rec, "LASER");
-    if (sonar) sonar = hw::recordRange(std::move(sonar), rec, "SONAR");
+    auto rec = std::make_shared<drivers::RawlogRecorder>(o.record);
+    camera = drivers::recordCamera(std::move(camera), rec);
+    base = drivers::recordBase(std::move(base), rec, ctx.clock);
+    if (laser) laser = drivers::recordRange(std::move(laser), rec, "LASER");
+    if (sonar) sonar = drivers::recordRange(std::move(sonar), rec, "SONAR");
   }
 
   // --- sketch -> route ----------------------------------------------------------------------
@@ -664,7 +664,7 @@ Json runNavigation(const RunOptions& o) {
       d["odometry_error_m"] =
           (odomToWorld(w.start, {o.x, o.y}) - Eigen::Vector2d(ot.x, ot.y)).norm();
       d["odometry_heading_error_deg"] =
-          nav::wrapAngle(w.start.theta + o.theta - ot.theta) * 180.0 / M_PI;
+          wrapAngle(w.start.theta + o.theta - ot.theta) * 180.0 / M_PI;
       if (observer.goal_odom) {
         const Eigen::Vector2d g = odomToWorld(w.start, *observer.goal_odom);
         d["goal_estimate_error_m"] = (g - w.goal.centre).norm();

@@ -8,6 +8,7 @@ EntryPoint byName(const std::string& name) {
   if (name == "config") return &config;
   if (name == "model") return &model;
   if (name == "protocol") return &baseProtocol;
+  if (name == "image") return &image;
   return nullptr;
 }
 

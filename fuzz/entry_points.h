@@ -31,8 +31,10 @@ void world(const std::uint8_t* data, std::size_t size);
 void config(const std::uint8_t* data, std::size_t size);
 void model(const std::uint8_t* data, std::size_t size);
 void baseProtocol(const std::uint8_t* data, std::size_t size);
+void image(const std::uint8_t* data, std::size_t size);
 
-/// The entry point named "sketch", "world", "config", "model" or "protocol"; nullptr if none.
+/// The entry point named "sketch", "world", "config", "model", "protocol" or "image"; nullptr
+/// if none.
 using EntryPoint = void (*)(const std::uint8_t*, std::size_t);
 EntryPoint byName(const std::string& name);
 

@@ -1,21 +1,21 @@
 #include "entry_points.h"
 
 #include "sketchnav/core/error.h"
-#include "sketchnav/hw/base_protocol.h"
+#include "sketchnav/drivers/base_protocol.h"
 
 namespace sketchnav::fuzz {
 
 void baseProtocol(const std::uint8_t* d, std::size_t n) {
-  hw::proto::Message m;
-  if (hw::proto::decode(d, n, m) == hw::proto::DecodeError::None) {
+  drivers::proto::Message m;
+  if (drivers::proto::decode(d, n, m) == drivers::proto::DecodeError::None) {
     // Whatever decodes must encode again and decode to the same type.
-    const auto again = hw::proto::encode(m);
-    hw::proto::Message m2;
-    if (hw::proto::decode(again.data(), again.size(), m2) != hw::proto::DecodeError::None ||
+    const auto again = drivers::proto::encode(m);
+    drivers::proto::Message m2;
+    if (drivers::proto::decode(again.data(), again.size(), m2) != drivers::proto::DecodeError::None ||
         m2.header.type != m.header.type)
       __builtin_trap();
   }
-  (void)hw::proto::decode(d, n, m, "fuzz-secret");
+  (void)drivers::proto::decode(d, n, m, "fuzz-secret");
 }
 
 }  // namespace sketchnav::fuzz

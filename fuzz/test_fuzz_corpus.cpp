@@ -66,6 +66,12 @@ TEST(FuzzCorpus, ConfigRegressions) {
   EXPECT_GT(replay("config", filesIn(kSource / "fuzz/regressions/config")), 0);
 }
 
+// Issue 28: 1x4000, 4000x1, a JPEG header claiming 1x60000 (and 30000x30000), truncated and
+// minimal files of each format readImageFile() takes.
+TEST(FuzzCorpus, ImageRegressionsAndSeeds) {
+  EXPECT_GE(replay("image", filesIn(kSource / "fuzz/regressions/image")), 10);
+}
+
 TEST(FuzzCorpus, ModelAndProtocolRegressions) {
   replay("model", filesIn(kSource / "fuzz/regressions/model"));
   replay("protocol", filesIn(kSource / "fuzz/regressions/protocol"));

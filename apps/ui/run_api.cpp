@@ -20,6 +20,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/hw/forwarding.h"
 
 namespace fs = std::filesystem;
 
@@ -222,14 +223,14 @@ struct RunController::Live {
 // stopped at once from the request's thread (its drivers take stop() from any thread, like
 // GatedBase's camera callback); the simulator is stepped by the run thread only, so there the
 // halt takes effect at the next control tick (50 ms of simulated time).
-class StoppableBase final : public hw::Base {
+class StoppableBase final : public hw::ForwardingBase {
  public:
   StoppableBase(std::unique_ptr<hw::Base> inner, std::shared_ptr<RunController::Live> live)
-      : inner_(std::move(inner)), live_(std::move(live)) {
+      : ForwardingBase(std::move(inner)), live_(std::move(live)) {
     std::lock_guard<std::mutex> l(live_->m);
     live_->base = this;
     live_->base_open = true;
-    live_->base_ok = inner_->ok();
+    live_->base_ok = this->inner().ok();
   }
   ~StoppableBase() override {
     std::lock_guard<std::mutex> l(live_->m);
@@ -242,9 +243,9 @@ class StoppableBase final : public hw::Base {
       std::lock_guard<std::mutex> l(m_);
       halted = halted_;
       if (halted)
-        inner_->stop();
+        inner().stop();
       else
-        inner_->command(v, w);
+        inner().command(v, w);
       seq = ++calls_;
     }
     // live_->m is taken after m_ is released (halt() takes them the other way round); `seq`
@@ -259,7 +260,7 @@ class StoppableBase final : public hw::Base {
       std::uint64_t seq;
       {
         std::lock_guard<std::mutex> l(m_);
-        inner_->stop();
+        inner().stop();
         seq = ++calls_;
       }
       record(0, 0, "stop", seq);
@@ -268,24 +269,24 @@ class StoppableBase final : public hw::Base {
   }
   bool odometry(hw::Odometry& out) override {
     std::lock_guard<std::mutex> l(m_);
-    return inner_->odometry(out);
+    return inner().odometry(out);
   }
   bool ok() const override {
     std::lock_guard<std::mutex> l(m_);
-    return inner_->ok();
+    return inner().ok();
   }
   hw::DeviceStats stats() const override {
     std::lock_guard<std::mutex> l(m_);
-    return inner_->stats();
+    return inner().stats();
   }
-  std::string uri() const override { return inner_->uri(); }
+  // uri() forwards as it is (no lock: the inner URI is fixed).
 
   /// Called with live_->m held (from RunController::stop()).
   void halt(bool from_this_thread) {
     halted_ = true;
     if (!from_this_thread) return;
     std::lock_guard<std::mutex> l(m_);
-    inner_->stop();
+    inner().stop();
     live_->base_seq = ++calls_;
     live_->v_sent = live_->w_sent = 0;
     live_->base_stops++;
@@ -298,8 +299,8 @@ class StoppableBase final : public hw::Base {
     hw::DeviceStats st;
     {
       std::lock_guard<std::mutex> l(m_);
-      ok = inner_->ok();
-      st = inner_->stats();
+      ok = inner().ok();
+      st = inner().stats();
     }
     std::lock_guard<std::mutex> l(live_->m);
     live_->base_ok = ok;
@@ -311,18 +312,17 @@ class StoppableBase final : public hw::Base {
     live_->w_sent = w;
     live_->base_last = what;
   }
-  std::unique_ptr<hw::Base> inner_;
   std::shared_ptr<RunController::Live> live_;
   mutable std::mutex m_;
-  std::uint64_t calls_ = 0;  // calls made to inner_ (guarded by m_)
+  std::uint64_t calls_ = 0;  // calls made to inner() (guarded by m_)
   std::atomic<bool> halted_{false};
 };
 
 // A Camera that keeps a copy of each frame for the page (live view and capture).
-class TapCamera final : public hw::Camera {
+class TapCamera final : public hw::ForwardingCamera {
  public:
   TapCamera(std::unique_ptr<hw::Camera> inner, std::shared_ptr<RunController::Live> live)
-      : inner_(std::move(inner)), live_(std::move(live)) {
+      : ForwardingCamera(std::move(inner)), live_(std::move(live)) {
     std::lock_guard<std::mutex> l(live_->m);
     live_->camera_open = true;
   }
@@ -331,8 +331,8 @@ class TapCamera final : public hw::Camera {
     live_->camera_open = false;
   }
   hw::GrabStatus grab(hw::Frame& frame, double timeout_s) override {
-    const hw::GrabStatus st = inner_->grab(frame, timeout_s);
-    const hw::DeviceStats stats = inner_->stats();
+    const hw::GrabStatus st = inner().grab(frame, timeout_s);
+    const hw::DeviceStats stats = inner().stats();
     cv::Mat copy;
     if (st == hw::GrabStatus::Ok && !frame.image.empty()) copy = frame.image.clone();
     std::lock_guard<std::mutex> l(live_->m);
@@ -345,12 +345,8 @@ class TapCamera final : public hw::Camera {
     }
     return st;
   }
-  hw::Intrinsics intrinsics() const override { return inner_->intrinsics(); }
-  hw::DeviceStats stats() const override { return inner_->stats(); }
-  std::string uri() const override { return inner_->uri(); }
 
  private:
-  std::unique_ptr<hw::Camera> inner_;
   std::shared_ptr<RunController::Live> live_;
 };
 

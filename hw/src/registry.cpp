@@ -5,8 +5,6 @@
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/input_file.h"
-#include "sketchnav/hw/file_cameras.h"
-#include "sketchnav/hw/hardware_drivers.h"
 
 namespace sketchnav::hw {
 namespace {
@@ -114,35 +112,6 @@ std::vector<std::string> Registry::baseSchemes() const {
 std::vector<std::string> Registry::rangeSchemes() const {
   std::lock_guard<std::mutex> lock(mutex_);
   return schemesOf(ranges_);
-}
-
-void registerBuiltinDrivers() {
-  Registry& r = Registry::instance();
-  r.addCamera(
-      "folder",
-      [](const Uri& uri, DeviceContext& ctx) -> std::unique_ptr<Camera> {
-        if (uri.path.empty())
-          throw InputError("camera URI '" + uri.text + "': expected folder:///absolute/path");
-        FolderCameraParams p;
-        applyConfig(p, ctx.config, "camera.folder");
-        p.fps = uri.paramDouble("fps", p.fps);
-        p.loop = uri.paramInt("loop", p.loop ? 1 : 0) != 0;
-        p.hfov_deg = uri.paramDouble("hfov_deg", p.hfov_deg);
-        p.validate();
-        return std::make_unique<FolderCamera>(uri.path, p, uri.text);
-      },
-      {"fps", "loop", "hfov_deg"});
-  r.addCamera("video",
-              [](const Uri& uri, DeviceContext&) -> std::unique_ptr<Camera> {
-                const std::string source = uri.path.empty() ? uri.authority : uri.path;
-                if (source.empty())
-                  throw InputError("camera URI '" + uri.text +
-                                   "': expected video:///file or video://INDEX");
-                return std::make_unique<VideoCamera>(source, uri.paramDouble("hfov_deg", 60.0),
-                                                     uri.text);
-              },
-              {"hfov_deg"});
-  registerHardwareDrivers();
 }
 
 }  // namespace sketchnav::hw

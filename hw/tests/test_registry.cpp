@@ -1,55 +1,29 @@
+// The registry alone (sketchnav::hw, no driver registered): factories by scheme, unknown
+// schemes and parameters named. The drivers' own schemes are tested in hw/drivers/tests.
 #include <gtest/gtest.h>
 
-#include <opencv2/imgcodecs.hpp>
+#include <cmath>
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/hw/registry.h"
-#include "test_data.h"
 
 using namespace sketchnav;
 using namespace sketchnav::hw;
 
-TEST(Registry, UnknownSchemeNamesItAndTheKnownOnes) {
-  registerBuiltinDrivers();
-  DeviceContext ctx;
-  try {
-    Registry::instance().createCamera("gopro://cam0", ctx);
-    FAIL();
-  } catch (const InputError& e) {
-    const std::string m = e.what();
-    EXPECT_NE(m.find("'gopro'"), std::string::npos) << m;
-    EXPECT_NE(m.find("folder"), std::string::npos) << m;
-    EXPECT_NE(m.find("video"), std::string::npos) << m;
+namespace {
+struct NullRange final : RangeSensor {
+  explicit NullRange(std::string u = "null://") : uri_(std::move(u)) {}
+  bool read(RangeScan& s) override {
+    s.ranges = {1.0f};
+    return true;
   }
-  EXPECT_THROW(Registry::instance().createBase("nobase://x", ctx), InputError);
-  EXPECT_THROW(Registry::instance().createRange("nolaser://x", ctx), InputError);
-  EXPECT_THROW(Registry::instance().createCamera("not a uri", ctx), InputError);
-}
-
-TEST(Registry, CreatesAFolderCameraWithUriParamsAndConfig) {
-  registerBuiltinDrivers();
-  const std::string dir = test::tempDir("registry");
-  cv::imwrite(dir + "/1.png", cv::Mat(10, 20, CV_8UC3, cv::Scalar(1, 2, 3)));
-  DeviceContext ctx;
-  ctx.config.set("camera.folder.hfov_deg=90");
-  auto cam = Registry::instance().createCamera("folder://" + dir + "?fps=4", ctx);
-  Frame f;
-  ASSERT_EQ(cam->grab(f), GrabStatus::Ok);
-  ASSERT_EQ(cam->grab(f), GrabStatus::EndOfStream);
-  EXPECT_NEAR(cam->intrinsics().fx, 10.0, 1e-9);  // 90 deg over 20 px
-  ctx.config.set("camera.folder.fps=-3");
-  EXPECT_THROW(Registry::instance().createCamera("folder://" + dir, ctx), InputError);
-}
+  DeviceStats stats() const override { return {}; }
+  std::string uri() const override { return uri_; }
+  std::string uri_;
+};
+}  // namespace
 
 TEST(Registry, CustomFactoriesAreUsedByScheme) {
-  struct NullRange final : RangeSensor {
-    bool read(RangeScan& s) override {
-      s.ranges = {1.0f};
-      return true;
-    }
-    DeviceStats stats() const override { return {}; }
-    std::string uri() const override { return "null://"; }
-  };
   Registry::instance().addRange(
       "null", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); });
   DeviceContext ctx;
@@ -59,43 +33,37 @@ TEST(Registry, CustomFactoriesAreUsedByScheme) {
   EXPECT_EQ(s.ranges.size(), 1u);
 }
 
-// Issue 28: an unknown URI parameter is an error like an unknown setting, before the device
-// is opened (folder:///x?fsp=10 ran at the default 30 fps).
-TEST(Registry, UnknownUriParameterNamesItAndTheClosestKnownOne) {
-  registerBuiltinDrivers();
-  const std::string dir = test::tempDir("registry-params");
-  cv::imwrite(dir + "/1.png", cv::Mat(10, 20, CV_8UC3, cv::Scalar(1, 2, 3)));
-  DeviceContext ctx;
-  auto message = [&](const std::string& uri) -> std::string {
-    try {
-      Registry::instance().createCamera(uri, ctx);
-    } catch (const InputError& e) {
-      return e.what();
-    }
-    return "";
-  };
-  EXPECT_EQ(
-      message("folder://" + dir + "?fsp=10"),
-      "camera URI 'folder://" + dir + "?fsp=10': unknown parameter 'fsp' (did you mean 'fps'?)");
-  EXPECT_EQ(message("folder://" + dir + "?fps=4&hfov=70"),
-            "camera URI 'folder://" + dir +
-                "?fps=4&hfov=70': unknown parameter 'hfov' (did you mean 'hfov_deg'?)");
-  // Checked before the factory runs: the folder need not exist for the parameter to be named.
-  EXPECT_NE(message("folder:///nonexistent-sketchnav?lop=1")
-                .find("unknown parameter 'lop' (did you mean 'loop'?)"),
-            std::string::npos);
-  EXPECT_EQ(message("folder://" + dir + "?fps=4&loop=1&hfov_deg=70"), "");
-  // A scheme registered without parameters takes none; "*" lets any key through.
-  struct NullRange final : RangeSensor {
-    bool read(RangeScan&) override { return false; }
-    DeviceStats stats() const override { return {}; }
-    std::string uri() const override { return "bare://"; }
-  };
+TEST(Registry, UnknownSchemeNamesItAndTheKnownOnes) {
   Registry::instance().addRange(
-      "bare", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); });
+      "null", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); });
+  DeviceContext ctx;
+  try {
+    Registry::instance().createRange("nolaser://x", ctx);
+    FAIL();
+  } catch (const InputError& e) {
+    const std::string m = e.what();
+    EXPECT_NE(m.find("'nolaser'"), std::string::npos) << m;
+    EXPECT_NE(m.find("null"), std::string::npos) << m;
+  }
+  EXPECT_THROW(Registry::instance().createRange("not a uri", ctx), InputError);
+}
+
+// A scheme registered without parameters takes none; "*" lets any key through; a known one
+// abbreviated or misspelt is named.
+TEST(Registry, UnknownUriParameterIsRefusedBeforeTheFactoryRuns) {
+  int made = 0;
+  Registry::instance().addRange(
+      "bare", [&made](const Uri&, DeviceContext&) {
+        ++made;
+        return std::make_unique<NullRange>();
+      });
   Registry::instance().addRange(
       "open", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); },
       {Registry::kAnyParameter});
+  Registry::instance().addRange(
+      "tuned", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); },
+      {"rate_hz", "loop"});
+  DeviceContext ctx;
   try {
     Registry::instance().createRange("bare://x?rate=3", ctx);
     FAIL();
@@ -104,5 +72,25 @@ TEST(Registry, UnknownUriParameterNamesItAndTheClosestKnownOne) {
                  "range sensor URI 'bare://x?rate=3': unknown parameter 'rate' (bare:// takes no "
                  "parameters)");
   }
+  EXPECT_EQ(made, 0);
+  try {
+    Registry::instance().createRange("tuned://x?rate=3", ctx);
+    FAIL();
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(),
+                 "range sensor URI 'tuned://x?rate=3': unknown parameter 'rate' (did you mean "
+                 "'rate_hz'?)");
+  }
   EXPECT_NO_THROW(Registry::instance().createRange("open://x?rate=3&anything=1", ctx));
+  EXPECT_NO_THROW(Registry::instance().createRange("tuned://x?rate_hz=3&loop=1", ctx));
+  EXPECT_NO_THROW(Registry::instance().createRange("bare://x", ctx));
+  EXPECT_EQ(made, 1);
+}
+
+TEST(Intrinsics, FromFovPutsThePrincipalPointAtTheCentre) {
+  const Intrinsics k = Intrinsics::fromFov(20, 10, M_PI / 2);
+  EXPECT_NEAR(k.fx, 10.0, 1e-12);
+  EXPECT_NEAR(k.fy, 10.0, 1e-12);
+  EXPECT_NEAR(k.cx, 9.5, 1e-12);
+  EXPECT_NEAR(k.cy, 4.5, 1e-12);
 }

@@ -7,20 +7,13 @@
 #include <sys/stat.h>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/landmarks/landmark_set.h"
 
 namespace fs = std::filesystem;
 
 namespace sketchnav::landmarks {
-
-bool isImageFile(const std::string& path) {
-  std::string ext = fs::path(path).extension().string();
-  std::transform(ext.begin(), ext.end(), ext.begin(),
-                 [](unsigned char c) { return static_cast<char>(std::tolower(c)); });
-  return ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp" || ext == ".tif" ||
-         ext == ".tiff" || ext == ".webp";
-}
 
 std::string classOfImage(const std::string& path) {
   return fs::path(path).parent_path().filename().string();
@@ -61,7 +54,7 @@ LandmarkSet scanLandmarkSet(const std::string& root) {
     }
     if (!subdirs.empty()) {
       for (const auto& f : files)
-        if (isImageFile(f.string()))
+        if (isImageFileName(f.string()))
           set.skipped.push_back(f.string() + ": photo outside a class (leaf) folder");
       stack.insert(stack.end(), subdirs.begin(), subdirs.end());
       continue;
@@ -69,7 +62,7 @@ LandmarkSet scanLandmarkSet(const std::string& root) {
     // (A root without sub-folders is itself one class, named after the folder.)
     std::vector<std::string> photos;
     for (const auto& f : files) {
-      if (isImageFile(f.string()))
+      if (isImageFileName(f.string()))
         photos.push_back(f.string());
       else
         set.skipped.push_back(f.string() + ": not a photo");

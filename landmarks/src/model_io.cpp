@@ -24,8 +24,8 @@
 
 #include <unistd.h>
 
-#include "model_internal.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/hash.h"
 #include "sketchnav/core/input_file.h"
 #include "sketchnav/core/json_io.h"
 #include "sketchnav/landmarks/colour_layout.h"
@@ -356,7 +356,7 @@ void LandmarkModel::save(const std::string& path) const {
   std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
   if (!out) throw RuntimeError(path + ": cannot write landmark model");
   const std::uint32_t version = kFormatVersion;
-  const std::uint64_t size = payload.size(), sum = detail::fnv1a(payload.data(), payload.size());
+  const std::uint64_t size = payload.size(), sum = fnv1a(payload.data(), payload.size());
   out.write(kMagic, sizeof kMagic);
   out.write(reinterpret_cast<const char*>(&version), sizeof version);
   out.write(reinterpret_cast<const char*>(&size), sizeof size);
@@ -401,7 +401,7 @@ LandmarkModel LandmarkModel::load(const std::string& path) {
                      std::to_string(data.size() - kHeader) + " of " + std::to_string(size) +
                      " bytes)");
   const char* payload = data.data() + kHeader;
-  if (detail::fnv1a(payload, size) != sum)
+  if (fnv1a(payload, size) != sum)
     throw InputError(path + ": corrupt landmark model (checksum mismatch)");
 
   // The checksum catches accidents, not a crafted file: every size below is checked before use.

@@ -7,8 +7,9 @@
 #include <filesystem>
 #include <mutex>
 
-#include "model_internal.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/hash.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/landmarks/colour_layout.h"
 #include "sketchnav/landmarks/landmark_set.h"
@@ -41,7 +42,7 @@ std::string landmarkSetFingerprint(const std::string& landmark_dir) {
               std::to_string(fs::file_size(p, ec)) + "\n";
   char buf[17];
   std::snprintf(buf, sizeof buf, "%016llx",
-                static_cast<unsigned long long>(detail::fnv1a(text.data(), text.size())));
+                static_cast<unsigned long long>(fnv1a(text.data(), text.size())));
   return buf;
 }
 
@@ -121,12 +122,10 @@ LandmarkModel trainModel(const std::string& landmark_dir, const ModelParams& par
     if (progress) progress("features", i, total);
     cv::Mat img;
     try {
-      img = cv::imread(items[i].path, cv::IMREAD_COLOR);
-    } catch (const cv::Exception&) {
-      img.release();
-    }
-    if (img.empty()) {
-      log::warn("landmarks", "skipping unreadable photo", {{"file", items[i].path}});
+      img = readImageFile(items[i].path, "photo");
+    } catch (const InputError& e) {
+      log::warn("landmarks", "skipping unreadable photo",
+                {{"file", items[i].path}, {"why", e.what()}});
       ++skipped;
       continue;
     }

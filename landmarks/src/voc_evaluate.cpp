@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <ctime>
 
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/landmarks/voc.h"
 
@@ -60,9 +62,12 @@ EvalResult evaluateProposals(const std::vector<VocImage>& images,
     const VocImage& im = images[i];
     if (progress) progress(static_cast<int>(i), static_cast<int>(images.size()), im.id);
     for (const auto& w : im.warnings) log::warn("propose", im.id + ": " + w);
-    const cv::Mat bgr = cv::imread(im.image_path, cv::IMREAD_COLOR);
-    if (bgr.empty()) {
-      log::warn("propose", "image unreadable or corrupt, skipped", {{"file", im.image_path}});
+    cv::Mat bgr;
+    try {
+      bgr = readImageFile(im.image_path, "image");
+    } catch (const InputError& e) {
+      log::warn("propose", "image unreadable or corrupt, skipped",
+                {{"file", im.image_path}, {"why", e.what()}});
       r.skipped.push_back(im.image_path);
       continue;
     }

@@ -10,6 +10,7 @@
 #include <random>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/hash.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/model.h"
 #include "test_data.h"
@@ -20,12 +21,6 @@ using namespace sketchnav::landmarks;
 
 namespace {
 constexpr size_t kHeader = 8 + 4 + 8 + 8;
-
-std::uint64_t fnv1a(const char* p, size_t n) {
-  std::uint64_t h = 1469598103934665603ull;
-  for (size_t i = 0; i < n; ++i) h = (h ^ static_cast<unsigned char>(p[i])) * 1099511628211ull;
-  return h;
-}
 
 // Fixes the payload size and checksum after a mutation, so the loader's own checks run.
 std::string reseal(std::string data) {

@@ -5,6 +5,7 @@
 #include <sstream>
 
 #include "geometry.h"
+#include "sketchnav/core/angles.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/mapsketch/io.h"
@@ -12,12 +13,6 @@
 
 namespace sketchnav::mapsketch {
 namespace {
-
-double wrapAngle(double a) {
-  while (a > M_PI) a -= 2 * M_PI;
-  while (a <= -M_PI) a += 2 * M_PI;
-  return a;
-}
 
 std::string fmt(double v, int prec = 3) {
   std::ostringstream o;

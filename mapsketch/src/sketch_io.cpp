@@ -7,6 +7,7 @@
 
 #include "geometry.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/input_file.h"
 #include "sketchnav/core/json_io.h"
 #include "sketchnav/mapsketch/io.h"
@@ -360,11 +361,7 @@ std::vector<std::string> landmarkClasses(const std::string& dir) {
     if (!e.is_directory()) continue;
     bool has_image = false;
     for (const auto& f : fs::directory_iterator(e.path(), ec)) {
-      std::string ext = f.path().extension().string();
-      std::transform(ext.begin(), ext.end(), ext.begin(),
-                     [](unsigned char c) { return std::tolower(c); });
-      if (f.is_regular_file() &&
-          (ext == ".jpg" || ext == ".jpeg" || ext == ".png" || ext == ".bmp")) {
+      if (f.is_regular_file() && isImageFileName(f.path().string())) {
         has_image = true;
         break;
       }

@@ -10,12 +10,6 @@
 
 namespace sketchnav::nav {
 
-double wrapAngle(double a) {
-  a = std::fmod(a + M_PI, 2 * M_PI);
-  if (a <= 0) a += 2 * M_PI;
-  return a - M_PI;
-}
-
 void SectionParams::validate() const {
   require(reach_radius_m > 0 && reach_radius_m < 5, "nav.sections.reach_radius_m",
           "must be in (0, 5) m");

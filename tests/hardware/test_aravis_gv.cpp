@@ -11,13 +11,15 @@
 
 #include "child_process.h"
 #include "sketchnav/core/error.h"
-#include "sketchnav/hw/aravis_camera.h"
-#include "sketchnav/hw/base_server.h"
+#include "sketchnav/drivers/aravis_camera.h"
+#include "sketchnav/drivers/base_server.h"
+#include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/gated_base.h"
 #include "sketchnav/hw/registry.h"
 
 using namespace sketchnav;
 using namespace sketchnav::hw;
+using namespace sketchnav::drivers;
 
 namespace {
 
@@ -48,7 +50,7 @@ TEST(AravisGv, StreamsConfiguredFramesFromAGigEVisionDeviceOnLoopback) {
   auto fake = startFakeCamera();
   ASSERT_TRUE(fake) << "could not start " << ARV_FAKE_GV_CAMERA
                     << " (apt-get install aravis-tools)";
-  registerBuiltinDrivers();
+  registerDrivers();
   DeviceContext ctx;
   auto cam = Registry::instance().createCamera(
       "aravis://127.0.0.1?pixel_format=BayerRG8&width=256&height=192&fps=30&exposure_us=5000"

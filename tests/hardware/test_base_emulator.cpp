@@ -13,11 +13,12 @@
 #include <thread>
 
 #include "child_process.h"
-#include "sketchnav/hw/base_protocol.h"
-#include "sketchnav/hw/dani_base.h"
+#include "sketchnav/drivers/base_protocol.h"
+#include "sketchnav/drivers/dani_base.h"
 
 using namespace sketchnav;
 using namespace sketchnav::hw;
+using namespace sketchnav::drivers;
 using proto::BaseState;
 using proto::Message;
 using proto::StopReason;

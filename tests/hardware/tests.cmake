@@ -11,7 +11,7 @@ if(SKETCHNAV_BUILD_TESTS)
     ${CMAKE_CURRENT_LIST_DIR}/test_aravis_gv.cpp
     ${CMAKE_CURRENT_LIST_DIR}/test_base_emulator.cpp)
   add_dependencies(test_hw_loopback sketchnav)  # the tests run the command itself
-  target_link_libraries(test_hw_loopback PRIVATE sketchnav::hw opencv_core
+  target_link_libraries(test_hw_loopback PRIVATE sketchnav::drivers opencv_core
                         sketchnav_test_support GTest::gtest_main)
   target_include_directories(test_hw_loopback PRIVATE ${CMAKE_CURRENT_LIST_DIR})
   target_compile_definitions(test_hw_loopback PRIVATE

@@ -10,6 +10,7 @@
 
 #include "run_harness.h"
 #include "sketchnav/hw/devices.h"
+#include "sketchnav/hw/forwarding.h"
 #include "test_data.h"
 
 using namespace sketchnav;
@@ -47,13 +48,13 @@ int countEvents(const std::string& dir, const std::string& type) {
 }
 
 // Delivers frames until `drop_at` seconds of simulated time, then nothing (a cable pulled).
-class DroppingCamera final : public hw::Camera {
+class DroppingCamera final : public hw::ForwardingCamera {
  public:
   DroppingCamera(std::unique_ptr<hw::Camera> inner, double drop_at, double* last_stamp)
-      : inner_(std::move(inner)), drop_at_(drop_at), last_stamp_(last_stamp) {}
+      : ForwardingCamera(std::move(inner)), drop_at_(drop_at), last_stamp_(last_stamp) {}
   hw::GrabStatus grab(hw::Frame& f, double timeout_s) override {
     if (dropped_) return hw::GrabStatus::Timeout;
-    const auto st = inner_->grab(f, timeout_s);
+    const auto st = inner().grab(f, timeout_s);
     if (st == hw::GrabStatus::Ok && f.stamp >= drop_at_) {
       dropped_ = true;
       return hw::GrabStatus::Timeout;
@@ -61,12 +62,8 @@ class DroppingCamera final : public hw::Camera {
     if (st == hw::GrabStatus::Ok) *last_stamp_ = f.stamp;
     return st;
   }
-  hw::Intrinsics intrinsics() const override { return inner_->intrinsics(); }
-  hw::DeviceStats stats() const override { return inner_->stats(); }
-  std::string uri() const override { return inner_->uri(); }
 
  private:
-  std::unique_ptr<hw::Camera> inner_;
   double drop_at_;
   bool dropped_ = false;
   double* last_stamp_;  // outlives the camera (the run destroys its devices)

@@ -5,58 +5,27 @@
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/hw/forwarding.h"
 #include "sketchnav/sim/simulator.h"
 
 namespace sketchnav::sim {
 namespace {
 
-// Thin device handles that keep the shared Simulator alive and forward to its devices.
-class CameraHandle final : public hw::Camera {
+// Thin device handles onto the shared Simulator's devices: each keeps the Simulator alive (an
+// aliasing shared_ptr) and reports the URI it was opened with; every other call forwards.
+template <class Forwarding, class Device>
+class Handle final : public Forwarding {
  public:
-  CameraHandle(std::shared_ptr<Simulator> s, std::string uri)
-      : s_(std::move(s)), uri_(std::move(uri)) {}
-  hw::GrabStatus grab(hw::Frame& f, double timeout_s) override {
-    return s_->camera().grab(f, timeout_s);
-  }
-  hw::Intrinsics intrinsics() const override { return s_->camera().intrinsics(); }
-  hw::DeviceStats stats() const override { return s_->camera().stats(); }
+  Handle(const std::shared_ptr<Simulator>& s, Device& device, std::string uri)
+      : Forwarding(std::shared_ptr<Device>(s, &device)), uri_(std::move(uri)) {}
   std::string uri() const override { return uri_; }
 
  private:
-  std::shared_ptr<Simulator> s_;
   std::string uri_;
 };
-
-class BaseHandle final : public hw::Base {
- public:
-  BaseHandle(std::shared_ptr<Simulator> s, std::string uri)
-      : s_(std::move(s)), uri_(std::move(uri)) {}
-  void command(double v, double w) override { s_->base().command(v, w); }
-  void stop() noexcept override { s_->base().stop(); }
-  bool odometry(hw::Odometry& o) override { return s_->base().odometry(o); }
-  bool ok() const override { return s_->base().ok(); }
-  hw::DeviceStats stats() const override { return s_->base().stats(); }
-  std::string uri() const override { return uri_; }
-
- private:
-  std::shared_ptr<Simulator> s_;
-  std::string uri_;
-};
-
-class RangeHandle final : public hw::RangeSensor {
- public:
-  RangeHandle(std::shared_ptr<Simulator> s, bool laser, std::string uri)
-      : s_(std::move(s)), laser_(laser), uri_(std::move(uri)) {}
-  bool read(hw::RangeScan& out) override { return dev().read(out); }
-  hw::DeviceStats stats() const override { return dev().stats(); }
-  std::string uri() const override { return uri_; }
-
- private:
-  hw::RangeSensor& dev() const { return laser_ ? s_->laser() : s_->sonar(); }
-  std::shared_ptr<Simulator> s_;
-  bool laser_;
-  std::string uri_;
-};
+using CameraHandle = Handle<hw::ForwardingCamera, hw::Camera>;
+using BaseHandle = Handle<hw::ForwardingBase, hw::Base>;
+using RangeHandle = Handle<hw::ForwardingRangeSensor, hw::RangeSensor>;
 
 }  // namespace
 
@@ -93,12 +62,14 @@ void registerDrivers() {
     auto& r = hw::Registry::instance();
     r.addCamera("sim",
                 [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
-                  return std::make_unique<CameraHandle>(simulatorFor(u.text, ctx), u.text);
+                  auto sim = simulatorFor(u.text, ctx);
+                  return std::make_unique<CameraHandle>(sim, sim->camera(), u.text);
                 },
                 {"seed", "realtime"});
     r.addBase("sim",
               [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
-                return std::make_unique<BaseHandle>(simulatorFor(u.text, ctx), u.text);
+                auto sim = simulatorFor(u.text, ctx);
+                return std::make_unique<BaseHandle>(sim, sim->base(), u.text);
               },
               {"seed", "realtime"});
     r.addRange("sim",
@@ -107,8 +78,9 @@ void registerDrivers() {
                  if (sensor != "laser" && sensor != "sonar")
                    throw InputError("'" + u.text + "': sensor must be laser or sonar, got '" +
                                     sensor + "'");
-                 return std::make_unique<RangeHandle>(simulatorFor(u.text, ctx), sensor == "laser",
-                                                      u.text);
+                 auto sim = simulatorFor(u.text, ctx);
+                 return std::make_unique<RangeHandle>(
+                     sim, sensor == "laser" ? sim->laser() : sim->sonar(), u.text);
                },
                {"sensor", "seed", "realtime"});
   });

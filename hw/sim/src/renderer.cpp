@@ -7,7 +7,7 @@
 #include <cmath>
 
 #include "sketchnav/core/error.h"
-#include "sketchnav/core/input_file.h"
+#include "sketchnav/core/image_file.h"
 
 namespace sketchnav::sim {
 namespace {
@@ -97,9 +97,7 @@ std::vector<Vec2> rect2(const Vec2& c, double hx, double hy, double yaw) {
 }
 
 cv::Mat loadTexture(const std::string& path, const std::string& what) {
-  requireRegularFile(path, what + ": texture");  // a FIFO would block imread for ever
-  cv::Mat t = cv::imread(path, cv::IMREAD_COLOR);
-  if (t.empty()) throw InputError(what + ": cannot decode texture '" + path + "'");
+  cv::Mat t = readImageFile(path, what + ": texture");
   const int longest = std::max(t.cols, t.rows);
   if (longest > 512) {
     cv::resize(t, t, cv::Size(), 512.0 / longest, 512.0 / longest, cv::INTER_AREA);

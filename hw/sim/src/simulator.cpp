@@ -14,24 +14,12 @@
 #include "renderer.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/hw/pose.h"
 
 namespace sketchnav::sim {
 
-double wrapAngle(double a) {
-  a = std::fmod(a + M_PI, 2 * M_PI);
-  if (a <= 0) a += 2 * M_PI;
-  return a - M_PI;
-}
-
-hw::Pose2D composePose(const hw::Pose2D& a, const hw::Pose2D& b) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  return {a.x + c * b.x - s * b.y, a.y + s * b.x + c * b.y, wrapAngle(a.theta + b.theta)};
-}
-
-hw::Pose2D inversePose(const hw::Pose2D& a) {
-  const double c = std::cos(a.theta), s = std::sin(a.theta);
-  return {-c * a.x - s * a.y, s * a.x - c * a.y, wrapAngle(-a.theta)};
-}
+using hw::composePose;
+using hw::inversePose;
 
 void SimParams::validate() const {
   require(substep >= 1e-4 && substep <= 0.1, "sim.substep", "must be in [0.0001, 0.1] s");

@@ -18,6 +18,7 @@
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/hw/pose.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
@@ -460,7 +461,7 @@ TEST(Odometry, ExactWithoutNoiseAndInTheStartFrame) {
   s.clock()->sleepUntil(4.0);
   hw::Odometry o;
   ASSERT_TRUE(s.base().odometry(o));
-  const hw::Pose2D truth_rel = sim::composePose(sim::inversePose(w.start), s.truePose());
+  const hw::Pose2D truth_rel = hw::composePose(hw::inversePose(w.start), s.truePose());
   EXPECT_NEAR(o.pose.x, truth_rel.x, 1e-6);
   EXPECT_NEAR(o.pose.y, truth_rel.y, 1e-6);
   EXPECT_NEAR(o.pose.theta, truth_rel.theta, 1e-6);
@@ -514,8 +515,8 @@ TEST(Odometry, HeadingSlipGrowsWithTurning) {
     sim::Simulator s(w, p);
     s.base().command(0.0, 1.0);
     s.clock()->sleepUntil(2.0);
-    const double truth = sim::wrapAngle(s.truePose().theta);
-    err.push_back(sim::wrapAngle(s.odometryPose().theta - truth));
+    const double truth = wrapAngle(s.truePose().theta);
+    err.push_back(wrapAngle(s.odometryPose().theta - truth));
   }
   double var = 0;
   for (double e : err) var += e * e;

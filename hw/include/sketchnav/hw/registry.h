@@ -1,8 +1,9 @@
 #pragma once
 // Devices are created from URIs through a registry keyed by scheme, not a type switch:
 //   auto cam = hw::Registry::instance().createCamera("folder:///data/frames?fps=10", ctx);
-// Drivers register themselves from registerBuiltinDrivers() (hw) and sim::registerDrivers()
-// (hw/sim); the command calls both once at start-up.
+// The registry knows no driver: drivers::registerDrivers() (hw/drivers: folder, video, aravis,
+// dani, laser, rawlog) and sim::registerDrivers() (hw/sim: sim) add their schemes; a program
+// calls both once at start-up. Linking sketchnav::hw alone links no vendor library.
 #include <any>
 #include <functional>
 #include <map>
@@ -74,9 +75,5 @@ class Registry {
 /// the first query key not in `known` (see Registry::Parameters).
 void requireKnownParameters(const Uri& uri, const std::string& kind,
                             const Registry::Parameters& known);
-
-/// Registers folder:// and video:// cameras (and, as they land, the hardware drivers).
-/// Idempotent.
-void registerBuiltinDrivers();
 
 }  // namespace sketchnav::hw

@@ -19,10 +19,7 @@ struct LandmarkSet {
   std::vector<std::string> skipped;    // files / folders ignored, with the reason
 };
 
-/// True for file names with a photo extension (.jpg .jpeg .png .bmp .tif .tiff .webp).
-bool isImageFile(const std::string& path);
-
-/// Scans `root`. Files that are not images and empty leaf folders are listed in `skipped`
+/// Scans `root`. Files that are not images (sketchnav::isImageFileName) and empty leaf folders are listed in `skipped`
 /// (and logged); whether a photo decodes is checked later, when it is read. Throws
 /// InputError naming `root` when it is not a folder or holds no photos at all. A root without
 /// sub-folders is one class named after it.

@@ -15,12 +15,11 @@
 #include <string>
 #include <vector>
 
+#include "sketchnav/core/angles.h"  // wrapAngle
 #include "sketchnav/hw/types.h"
 #include "sketchnav/mapsketch/route.h"
 
 namespace sketchnav::nav {
-
-double wrapAngle(double a);  // to (-pi, pi]
 
 struct SectionParams {
   double reach_radius_m = 0.35;  // [m] a section ends when its end point is this close...

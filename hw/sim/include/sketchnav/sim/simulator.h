@@ -161,9 +161,4 @@ class Simulator {
   std::unique_ptr<Impl> impl_;  // after world_/params_: it refers to them
 };
 
-/// Convenience: pose composition / conversions in the 2-D world.
-hw::Pose2D composePose(const hw::Pose2D& a, const hw::Pose2D& b);  // a ⊕ b
-hw::Pose2D inversePose(const hw::Pose2D& a);
-double wrapAngle(double a);  // to (-pi, pi]
-
 }  // namespace sketchnav::sim

@@ -102,6 +102,11 @@ struct CameraSpec {
 };
 
 /// A planar laser scanner: beams from -fov/2 to +fov/2 around its mounting yaw.
+/// Highest scan rate a world may give its laser or sonar [Hz] (real scanners run at 10-50 Hz,
+/// sonar rings at 10-25 Hz). A world file above it is refused: each scan costs a ray cast, and
+/// 1e9 Hz made `sim drive` take more than 40 s.
+constexpr double kMaxRangeRateHz = 100.0;
+
 struct LaserSpec {
   bool enabled = true;
   double x = 0.15, y = 0.0, z = 0.25, yaw = 0.0;  // [m], [rad] mount in the robot frame
@@ -110,7 +115,7 @@ struct LaserSpec {
   double min_range = 0.05;  // [m]
   double max_range = 8.0;   // [m]
   double noise_std = 0.01;  // [m] Gaussian range noise
-  double rate_hz = 10.0;    // [Hz] a new scan every 1/rate_hz
+  double rate_hz = 10.0;    // [Hz] a new scan every 1/rate_hz; in (0, kMaxRangeRateHz]
 };
 
 /// One sonar transducer: position and yaw in the robot frame.
@@ -127,7 +132,7 @@ struct SonarSpec {
   double min_range = 0.05;       // [m]
   double max_range = 4.0;        // [m]
   double noise_std = 0.02;       // [m]
-  double rate_hz = 10.0;         // [Hz]
+  double rate_hz = 10.0;         // [Hz] in (0, kMaxRangeRateHz]
 };
 
 /// The robot's body for collisions: a disc (DaNI-sized).
