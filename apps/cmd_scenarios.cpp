@@ -151,11 +151,14 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   Args args("scenarios",
             "generate seeded worlds with human-like sketches; --run: the benchmark over them",
             "--generate N [--families corridor,hall,office,mixed] [--seed S] [--out DIR] [--run] "
-            "[--jobs J] [--max-time T]");
+            "[--jobs J] [--max-time T] | --regression [--run] ...");
   args.option("generate", "how many scenarios (scenario k: family k mod families, seed S + k)")
       .option("families", "comma separated families", "corridor,hall,office,mixed")
       .option("seed", "first seed", "1")
       .option("out", "output folder (default: runs/<UTC timestamp>)")
+      .flag("regression",
+            "the fixed regression set: dev seeds 1-48, all four families (12 each); instead of "
+            "--generate / --seed / --families")
       .flag("run", "run every scenario in simulation and report the benchmark")
       .flag("reuse", "with --run: keep runs already in <out>/runs/<name>/summary.json")
       .option("jobs", "runs in parallel (child processes)", "2")
@@ -165,16 +168,22 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
               "set; with another set give --model trained on it)")
       .option("max-time", "give up each run after this many simulated seconds", "300");
   if (!args.parse(argv)) return 0;
-  if (args.get("generate").empty()) throw InputError("--generate N is required");
-  const int n = args.getInt("generate");
-  const int seed0 = args.getInt("seed");
+  const bool regression = args.flagSet("regression");
+  if (regression && !args.get("generate").empty())
+    throw InputError("--regression is a fixed set: give it without --generate");
+  if (!regression && args.get("generate").empty()) throw InputError("--generate N is required");
+  // The regression set: scenarios 0..47 from seed 1 over the four families (development seeds,
+  // doc/experiments.md); the held-out range is never part of it.
+  const int n = regression ? 48 : args.getInt("generate");
+  const int seed0 = regression ? 1 : args.getInt("seed");
   const int jobs = args.getInt("jobs");
   if (n < 1 || n > 100000) throw InputError("--generate must be in 1..100000");
   if (seed0 < 0) throw InputError("--seed must be >= 0");
   if (jobs < 1 || jobs > 64) throw InputError("--jobs must be in 1..64");
   const double max_time = args.getDouble("max-time");
   if (!(max_time > 0)) throw InputError("--max-time must be positive");
-  const auto families = args.getList("families");
+  const auto families = regression ? std::vector<std::string>{"corridor", "hall", "office", "mixed"}
+                                    : args.getList("families");
   for (const auto& f : families)
     if (std::find(scenarioFamilies().begin(), scenarioFamilies().end(), f) ==
         scenarioFamilies().end())

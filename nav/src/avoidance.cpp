@@ -179,8 +179,8 @@ bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
   const Eigen::Vector2d d = Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos;
   const double reach = P.robot_radius_m + P.person_radius_m;
   const double along = d.dot(u);
-  // Passed (the robot is behind them), or not reached within the horizon.
-  if (along < -reach || along > speed * P.lane_horizon_s + reach) return false;
+  // Passed (the robot is behind them, by the gap kept), or not reached within the horizon.
+  if (along < -(reach + P.lane_margin_m) || along > speed * P.lane_horizon_s + reach) return false;
   const Eigen::Vector2d lateral = d - along * u;
   offset = lateral.norm();
   if (offset >= reach + P.lane_margin_m) return false;
@@ -215,82 +215,113 @@ double ObstacleAvoider::forwardSpeed(double dir, double v, AvoidOutput& out) con
 void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& pts,
                                  double target_bearing, double heading, double v_nominal,
                                  const Eigen::Vector2d& lane_n, double lane_off, AvoidOutput& out) {
-  // Out of the walker's lane, steeply: a shallow angle gains too little sideways before they
-  // arrive (at 25 deg off the axis an exp4-pedestrian-left robot gained 0.13 m/s and was
-  // walked into 0.07 m short of clear). Of the directions that leave steeply enough, the one
-  // nearest the route's; the side is the one the robot is already on, and when it is on the
-  // axis, the chosen side first.
+  // Out of the walker's lane to the side with room, steeply, then stand still there until they
+  // have passed. Room is what the laser shows along each normal to the lane's axis (a corridor
+  // wall, furniture): the robot goes as far out as the lane's width asks, or as far as that
+  // side allows with the minimum clearance kept, whichever is less; where neither side leaves
+  // the lane entirely, the side that leaves the larger gap. Moving only while it gains
+  // sideways, it does not turn back and forth in front of the walker.
   const auto& P = params_;
-  const double hw = P.robot_radius_m + P.corridor_margin_m;
   const double c = std::cos(heading), sn = std::sin(heading);
   auto toRobot = [&](const Eigen::Vector2d& w) {
     return Eigen::Vector2d(c * w.x() + sn * w.y(), -sn * w.x() + c * w.y());
   };
   const Eigen::Vector2d u = walker_.vel.normalized();
   const Eigen::Vector2d perp(-u.y(), u.x());
-  // The side is chosen once per lane and kept (also when the lane lapses for a moment): near
-  // the axis the estimate of which side the robot is on flips from scan to scan, and so would
-  // the robot. Chosen by the sooner out: the turn to a steep enough direction plus the way
-  // sideways to clear the lane. By the side the robot is on alone, a robot 0.1 m off the axis
-  // facing south out of it turned round on the spot to leave northwards and was walked into
-  // while turning (exp4-pedestrian-left #3).
-  const double need = std::sin(P.lane_escape_deg * M_PI / 180);
-  if (lane_sign_ == 0) {
-    const double clear = P.robot_radius_m + P.person_radius_m + P.lane_margin_m;
-    double best_t = 1e300;
-    for (const int sign : {1, -1}) {
-      const Eigen::Vector2d n = sign * perp, nr = toRobot(n);
-      const double turn = std::max(
-          0.0, std::abs(std::atan2(nr.y(), nr.x())) - (M_PI / 2 - P.lane_escape_deg * M_PI / 180));
-      const double side_off = lane_n.dot(n) >= 0 ? lane_off : -lane_off;
-      const double t =
-          turn / P.max_turn_rate + (clear - side_off) / (std::max(v_nominal, 0.05) * need);
-      if (t < best_t) best_t = t, lane_sign_ = sign;
-    }
+  const double clear = P.robot_radius_m + P.person_radius_m + P.lane_margin_m;  // offset wanted
+  const double steep = std::sin(P.lane_escape_deg * M_PI / 180);
+  // Signed offset of the robot from the axis along perp.
+  const double so = lane_n.dot(perp) >= 0 ? lane_off : -lane_off;
+  // The room a side leaves (along its normal, the robot's disc kept min_clearance_m off what
+  // the laser sees), the offset it allows (capped at `clear`) and the time to get there (turn
+  // + sideways drive).
+  struct Side {
+    double room = 0, reach = 0, time = 0;
+  };
+  auto side = [&](int sign) {
+    const Eigen::Vector2d n = sign * perp, nr = toRobot(n);
+    const double a = std::atan2(nr.y(), nr.x());
+    Side r;
+    r.room =
+        std::max(0.0, corridorFree(pts, a, P.robot_radius_m, P.max_range_m) - P.min_clearance_m);
+    const double now_off = sign * so;
+    r.reach = std::min(clear, now_off + r.room);
+    const double turn = std::max(0.0, std::abs(a) - (M_PI / 2 - P.lane_escape_deg * M_PI / 180));
+    r.time = turn / P.max_turn_rate +
+             std::max(0.0, r.reach - now_off) / (std::max(v_nominal, 0.05) * steep);
+    return r;
+  };
+  const Side s_pos = side(1), s_neg = side(-1);
+  const int own = so >= 0 ? 1 : -1;
+  const Side& own_side = own > 0 ? s_pos : s_neg;
+  if (lane_sign_ == 0 && std::abs(so) >= 0.15 &&
+      own_side.reach >= P.robot_radius_m + P.person_radius_m + 0.1) {
+    // Off the axis with room on that side: that side (going across is crossing in front).
+    lane_sign_ = own;
+  } else if (lane_sign_ == 0) {
+    // Near the axis: the side that leaves the larger gap; where both leave the lane (or about
+    // the same), the sooner out.
+    if (s_pos.reach > s_neg.reach + 0.1)
+      lane_sign_ = 1;
+    else if (s_neg.reach > s_pos.reach + 0.1)
+      lane_sign_ = -1;
+    else
+      lane_sign_ = s_neg.time < s_pos.time ? -1 : 1;
+  } else {
+    // Kept once chosen: near the axis the side the robot is on flips with the walker's
+    // estimated heading, and so would the robot. Given up only while the robot is still near
+    // the axis, when its side is closed and the other is not (further out, going back across
+    // is crossing in front of the walker).
+    const Side& mine = lane_sign_ > 0 ? s_pos : s_neg;
+    const Side& other = lane_sign_ > 0 ? s_neg : s_pos;
+    if (lane_sign_ * so < 0.15 && mine.room < 0.1 && other.room > 0.3 &&
+        other.reach > mine.reach + 0.2)
+      lane_sign_ = -lane_sign_;
   }
-  const std::vector<Eigen::Vector2d> normals{lane_sign_ * perp, -lane_sign_ * perp};
-  auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= P.trigger_m; };
-  bool found = false;
-  double dir = 0;
-  Eigen::Vector2d n_used = normals.front();
-  for (const auto& n : normals) {
-    const Eigen::Vector2d nr = toRobot(n);
-    double best = 1e9, best_out = -1e9;
-    double fallback = 0;
+  const Side& goal = lane_sign_ > 0 ? s_pos : s_neg;
+  const Eigen::Vector2d n = lane_sign_ * perp, nr = toRobot(n);
+  const double now_off = lane_sign_ * so;
+  side_ = nr.y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
+  double v = 0, dir = 0;
+  bool steer = false;
+  const double togo = std::min(goal.reach, clear) - now_off;
+  if (togo > 0.03 && goal.room > 0.03) {
+    // Of the directions that leave steeply enough and have room for the next few centimetres,
+    // the quickest out: the turn to it plus the drive sideways; ties to the route's.
+    double best = 1e300, best_free = 0;
     for (int i = -35; i <= 36; ++i) {
       const double a = i * 5 * M_PI / 180;
-      if (!open(a)) continue;
       const double away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
-      if (away >= need) {
-        const double dev = std::abs(wrapAngle(a - target_bearing));
-        if (dev < best) best = dev, dir = a;
-      }
-      if (away > best_out) best_out = away, fallback = a;
+      if (away < steep - 1e-9) continue;
+      const double free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
+      if (free < P.min_clearance_m + 0.02) continue;
+      const double t = std::abs(a) / P.max_turn_rate + togo / (std::max(v_nominal, 0.05) * away) +
+                       0.01 * std::abs(wrapAngle(a - target_bearing));
+      if (t < best) best = t, dir = a, best_free = free, steer = true;
     }
-    if (best < 1e9 || best_out > 0.2) {
-      if (best >= 1e9) dir = fallback;
-      found = true;
-      n_used = n;
-      if (n.dot(perp) * lane_sign_ < 0) lane_sign_ = -lane_sign_;  // that side is closed
-      break;
+    if (steer) {
+      // Turn first beyond 1 rad; then drive, slowing down over the last 0.15 m before what is
+      // ahead in that direction and over the last 0.1 m of the offset wanted.
+      v = std::abs(dir) > 1.0 ? 0.0 : v_nominal * (std::abs(dir) > 0.5 ? std::cos(dir) : 1.0);
+      v *= std::clamp((best_free - P.min_clearance_m) / 0.15, 0.3, 1.0);
+      v *= std::clamp(togo / 0.1, 0.3, 1.0);
+      prev_dir_odom_ = wrapAngle(heading + dir);
+      have_prev_ = true;
+    } else {
+      // Nothing open leads further out: stand still (turning now only costs time), backing off
+      // only when that also leads out of the lane.
+      if (-nr.x() >= steep && corridorFree(pts, M_PI, P.robot_radius_m, P.max_range_m) > 0.5)
+        v = -P.reverse_speed;
+      out.blocked = true;
+      have_prev_ = false;
     }
-  }
-  side_ = toRobot(n_used).y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
-  double v = 0;
-  if (found) {
-    v = forwardSpeed(dir, v_nominal, out);
-    prev_dir_odom_ = wrapAngle(heading + dir);
-    have_prev_ = true;
   } else {
-    // Nowhere open leads out: back away if that does, else face out of the lane.
-    const Eigen::Vector2d nr = toRobot(n_used);
-    dir = std::atan2(nr.y(), nr.x());
-    if (-nr.x() >= 0 && corridorFree(pts, M_PI, hw, P.max_range_m) > 0.5) v = -P.reverse_speed;
-    out.blocked = true;
+    // As far out as this side allows: stand still until the walker has passed.
     have_prev_ = false;
   }
   out.direction = dir;
-  out.w = P.k_heading * dir;
+  out.w = steer ? P.k_heading * dir : 0.0;
+  out.v = v;
   out.v = v;
 }
 
@@ -394,7 +425,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
                                  : 1e9;
   if (!active_) {
     if (std::min(out.front_free_m, target_free) >= trigger &&
-        walker_gap >= P.trigger_m + walker_.vel.norm() * P.approach_horizon_s) {
+        walker_gap >= P.trigger_m + walker_.vel.norm() * P.lane_horizon_s) {
       prev_v_ = v_nominal;
       return out;
     }

@@ -2,6 +2,7 @@
 // side, the other side when that one is closed, minimum clearance, corridor geometry.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 
 #include "scan_sim.h"
@@ -202,6 +203,82 @@ TEST(Avoider, KeepsOutOfAWalkersLaneUntilTheyHavePassed) {
       EXPECT_TRUE(arrived) << "lane " << lane_y << " start " << start_x;
     }
   }
+}
+
+namespace {
+// A robot driving east along a straight corridor (inner faces at y = +-half_width) at 0.3 m/s
+// meets a person who keeps walking along it at `speed`, `lane_y` off the centre line, coming
+// west from `start_x` (and, with `turn_at` > 0, first walking east and turning back there).
+// Closed loop at 10 Hz, laser only, the avoider's own detection plus the mover tracker's offer
+// (its walker estimate: the true position and velocity, once the person is within 4 m).
+// Returns the smallest gap between the two bodies [m] (robot 0.2 m, person 0.25 m) and whether
+// the robot got to x = 12 within 80 s.
+struct CorridorMeet {
+  double gap = 1e9;
+  bool arrived = false;
+};
+CorridorMeet meetInCorridor(double half_width, double lane_y, double speed, double start_x,
+                            double turn_at = 0) {
+  const std::vector<test::Box> walls{{6, half_width + 0.05, 9, 0.05},
+                                     {6, -half_width - 0.05, 9, 0.05}};
+  ObstacleAvoider a;
+  hw::Pose2D pose{0, 0, 0};
+  CorridorMeet r;
+  for (int k = 0; k < 800 && !r.arrived; ++k) {
+    const double t = 0.1 * k;
+    // Walking east to turn_at first (when given), then west for good.
+    double wx = start_x, vx = -speed;
+    if (turn_at > start_x) {
+      const double t_turn = (turn_at - start_x) / speed;
+      wx = t < t_turn ? start_x + speed * t : turn_at - speed * (t - t_turn);
+      vx = t < t_turn ? speed : -speed;
+    } else {
+      wx = start_x - speed * t;
+    }
+    const test::Disc walker{wx, lane_y, 0.25};
+    r.gap = std::min(r.gap, std::hypot(walker.cx - pose.x, walker.cy - pose.y) - 0.45);
+    // Route following: towards the centre line 1.5 m ahead.
+    const double tb = std::remainder(std::atan2(-pose.y, 1.5) - pose.theta, 2 * M_PI);
+    a.setPose(pose);
+    if (std::hypot(wx - pose.x, lane_y - pose.y) < 4.0)
+      a.offerWalker({wx, lane_y}, {vx, 0.0});
+    const auto scan = test::scanAt(pose, walls, {walker}, t);
+    const auto out = a.step({scan}, tb, DodgeSide::Left, pose.theta, 0.3, t);
+    const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
+    const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
+    pose.x += v * std::cos(pose.theta) * 0.1;
+    pose.y += v * std::sin(pose.theta) * 0.1;
+    pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+    r.arrived = pose.x > 12.0;
+  }
+  return r;
+}
+}  // namespace
+
+TEST(Avoider, KeepsAPersonWalkingTheCorridorAtLeast30cmAway) {
+  // Issue 25: people who keep walking along a corridor (the generated scenarios' 1.8-2.6 m
+  // corridors, walkers +-0.3 m off the centre line at 0.3-0.6 m/s) walked into a robot that
+  // turned on the spot between the two sides. The robot must step to the side with room in
+  // time and stay there until they have passed: >= 0.3 m between the bodies wherever the
+  // corridor leaves room for it (half width 1.1 m: a robot against a wall is 0.78 m off the
+  // centre), and then carry on.
+  for (const double lane_y : {-0.3, -0.1, 0.0, 0.1, 0.3})
+    for (const double speed : {0.3, 0.45, 0.6}) {
+      const auto m = meetInCorridor(1.1, lane_y, speed, 6.0);
+      EXPECT_GE(m.gap, 0.3) << "lane " << lane_y << " speed " << speed;
+      EXPECT_TRUE(m.arrived) << "lane " << lane_y << " speed " << speed;
+    }
+}
+
+TEST(Avoider, KeepsClearOfAPersonWhoWalksAheadAndTurnsBack) {
+  // The same corridor; the person walks ahead of the robot, away from it, then turns back at
+  // x = 5 and comes towards it (the scenarios' walkers go back and forth along a stretch).
+  for (const double lane_y : {-0.2, 0.0, 0.2})
+    for (const double speed : {0.3, 0.5}) {
+      const auto m = meetInCorridor(1.1, lane_y, speed, 2.5, 5.0);
+      EXPECT_GE(m.gap, 0.3) << "lane " << lane_y << " speed " << speed;
+      EXPECT_TRUE(m.arrived) << "lane " << lane_y << " speed " << speed;
+    }
 }
 
 TEST(Avoider, StepsOutOfTheLaneOfAWalkerTheTrackerSawComingFromTheSide) {

@@ -222,6 +222,29 @@ TEST(SectionTracker, FitSimilarityRecoversRotationScaleAndShift) {
   EXPECT_LT((t.toOdom({14, -4}) - f.odom.back()).norm(), 1e-9);
 }
 
+TEST(SectionTracker, OneFitTakesOutDistancesThatWereAllSaid30PercentShort) {
+  // Issue 25: every distance said 30 % short (the world is 1/0.7 = 1.43 x the drawing). The
+  // fixes agree on that scale, so the fit takes it, however few fits there are: with a bound
+  // per fit (15 %) and one fit the goal stayed metres short. The start (trusted, at the odometry
+  // origin) and two landmarks: one fit, weighted, as the executive makes it.
+  for (const double s : {1 / 0.7, 1 / 1.3, 1.0}) {
+    SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+    const Fixes f = seenThrough(s, 0.0, {0, 0});
+    std::vector<WeightedFix> wf{{f.route[0], f.odom[0], 1e4 * Eigen::Matrix2d::Identity(), true},
+                                {f.route[2], f.odom[2], 25 * Eigen::Matrix2d::Identity(), false},
+                                {f.route[4], f.odom[4], 25 * Eigen::Matrix2d::Identity(), false}};
+    const auto fit = t.fitSimilarityWeighted(wf, WeightedFitParams{});
+    ASSERT_TRUE(fit.ok) << s;
+    EXPECT_NEAR(t.scale(), s, 0.01 * s) << s;
+    EXPECT_LT((t.toOdom({14, -4}) - f.odom.back()).norm(), 0.2) << s;
+  }
+  // The bound holds against the drawing's own scale, over any number of fits.
+  SectionTracker t(makeRoute({{0, 0}, {10, 0}, {14, -4}}));
+  const Fixes f = seenThrough(2.0, 0.0, {0, 0});
+  for (int k = 0; k < 4; ++k) ASSERT_TRUE(t.fitSimilarity(f.route, f.odom, 0.5).ok);
+  EXPECT_NEAR(t.scale(), 1.5, 1e-9);
+}
+
 TEST(SectionTracker, FitSimilarityLeavesOutAFixFarOffTheOthers) {
   const Fixes f0 = seenThrough(1.0, 0.05, {0, 0});
   Fixes f = f0;

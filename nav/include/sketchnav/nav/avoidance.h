@@ -54,7 +54,7 @@ struct AvoidParams {
   // direction taken leaves the lane at lane_escape_deg or more to its axis.
   double lane_horizon_s = 6.0;   // [s]
   double person_radius_m = 0.3;  // [m]
-  double lane_margin_m = 0.15;   // [m]
+  double lane_margin_m = 0.35;   // [m] gap kept between the two bodies (out of the lane)
   double lane_escape_deg = 60;   // [deg] from the lane's axis (90 = straight out sideways)
   double max_turn_rate = 0.8;    // [rad/s] how fast the base turns (nav.max_w), to choose the
                                  // side out of a lane

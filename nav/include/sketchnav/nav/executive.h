@@ -64,7 +64,7 @@ struct ExecutiveParams {
   // distorted smoothly (one room drawn too small) would want fewer fixes and a local shift.
   int fit_fixes = 100;
   double fit_min_span_m = 5.0;         // [m]
-  double fit_max_scale_change = 0.15;  // relative, per fit
+  double fit_max_scale_change = 0.5;  // relative to the drawing's own scale, over all fits
   double fit_local_gain = 0.0;
   // The start stays in every fit: it is where the user put the robot, and it gives the fit a
   // baseline as long as the route. Fitting only the last fit_fixes landmarks (5-7 m apart)

@@ -75,7 +75,7 @@ struct WeightedFitParams {
   double sketch_sigma_m = 0.3;     // [m] how far off the user draws a landmark (per axis)
   double outlier_m = 0.6;          // [m] a fix further than this off the fit (Mahalanobis
                                    // distance x sketch_sigma_m) is left out
-  double max_scale_change = 0.15;  // relative, per fit
+  double max_scale_change = 0.5;  // relative to the drawing's own scale (route metres)
 };
 
 struct SectionProgress {
@@ -123,8 +123,8 @@ class SectionTracker {
   /// squares: `route_pts[i]` (sketch) was seen at `odom_pts[i]`. A hand-drawn map's scale comes
   /// from the user's distance guesses (10-25 % off each); several fixes a few metres apart pin
   /// scale and heading down far better, and the error of each sketched position averages out
-  /// instead of being copied by a shift. The scale moves at most `max_scale_change` (relative)
-  /// per fit. Needs two or more fixes. With `outlier_m` > 0, the fix furthest off the fit is
+  /// instead of being copied by a shift. The scale stays within `max_scale_change` (relative)
+  /// of the drawing's own. Needs two or more fixes. With `outlier_m` > 0, the fix furthest off the fit is
   /// left out and the rest refitted while it is more than `outlier_m` off and more than three
   /// fixes remain.
   struct Fit {
@@ -136,7 +136,7 @@ class SectionTracker {
     std::vector<bool> used;  // per fix: kept in the fit
   };
   Fit fitSimilarity(const std::vector<Eigen::Vector2d>& route_pts,
-                    const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.15,
+                    const std::vector<Eigen::Vector2d>& odom_pts, double max_scale_change = 0.5,
                     double outlier_m = 0);
   /// The same refit with each fix weighted by how well it was observed plus the sketch's own
   /// error (sketch_sigma_m, once per landmark): a landmark located only across its rays (the
