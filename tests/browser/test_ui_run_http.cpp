@@ -224,10 +224,18 @@ TEST_F(UiRunHttp, StartShowsProgressAndStopStopsTheBase) {
   const cv::Vec3b edge = img.at<cv::Vec3b>(120, 100);
   EXPECT_GT(edge[1], 150);
   EXPECT_LT(edge[2], 120);
-  // The objectness windows of that frame, thin and blue-ish, computed once per frame shown.
+  // The objectness windows of that frame, thin, blue-ish and faded, computed once per frame
+  // shown: the pixel on a window's edge is much bluer than the same pixel drawn without them.
   const cv::Vec3b win = img.at<cv::Vec3b>(35, 10);
-  EXPECT_GT(win[0], win[2] + 40);
   EXPECT_EQ(windows_calls_.load(), 1);
+  auto f0 = cli_->Get("/api/run/frame.jpg?windows=0");
+  ASSERT_EQ(f0->status, 200);
+  const cv::Mat bare =
+      cv::imdecode(std::vector<unsigned char>(f0->body.begin(), f0->body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(bare.size(), img.size());
+  const cv::Vec3b b0 = bare.at<cv::Vec3b>(35, 10);
+  EXPECT_GT(int(win[0]) - int(win[2]), int(b0[0]) - int(b0[2]) + 40);
+  EXPECT_EQ(windows_calls_.load(), 1);  // the second drawing reused them
   EXPECT_EQ(s["perception"]["detections"], 1);
 
   auto m = body(cli_->Get("/api/run/map"));
