@@ -17,9 +17,9 @@
 
 #include "cli.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
-#include "sketchnav/core/image_file.h"
 #include "sketchnav/landmarks/baselines.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/voc.h"

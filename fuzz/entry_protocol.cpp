@@ -11,7 +11,8 @@ void baseProtocol(const std::uint8_t* d, std::size_t n) {
     // Whatever decodes must encode again and decode to the same type.
     const auto again = drivers::proto::encode(m);
     drivers::proto::Message m2;
-    if (drivers::proto::decode(again.data(), again.size(), m2) != drivers::proto::DecodeError::None ||
+    if (drivers::proto::decode(again.data(), again.size(), m2) !=
+            drivers::proto::DecodeError::None ||
         m2.header.type != m.header.type)
       __builtin_trap();
   }

@@ -14,8 +14,8 @@ using sketchnav::wrapAngle;
 
 TEST(WrapAngle, MapsIntoMinusPiToPiAndKeepsTheDirection) {
   EXPECT_NEAR(wrapAngle(0.0), 0.0, 1e-15);
-  EXPECT_NEAR(wrapAngle(M_PI), M_PI, 1e-12);    // pi is in range ...
-  EXPECT_NEAR(wrapAngle(-M_PI), M_PI, 1e-12);   // ... -pi is not
+  EXPECT_NEAR(wrapAngle(M_PI), M_PI, 1e-12);   // pi is in range ...
+  EXPECT_NEAR(wrapAngle(-M_PI), M_PI, 1e-12);  // ... -pi is not
   EXPECT_NEAR(wrapAngle(3 * M_PI / 2), -M_PI / 2, 1e-12);
   EXPECT_NEAR(wrapAngle(-3 * M_PI / 2), M_PI / 2, 1e-12);
   EXPECT_NEAR(wrapAngle(20 * M_PI + 0.25), 0.25, 1e-12);

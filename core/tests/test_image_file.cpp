@@ -213,8 +213,8 @@ TEST(ImageFile, DecodeImageAppliesTheSameRuleToBytesInMemory) {
 }
 
 TEST(ImageFile, OneListOfImageFileNames) {
-  for (const char* yes : {"a.jpg", "b.JPEG", "c.png", "d.Bmp", "e.pgm", "f.ppm", "g.pnm",
-                          "h.tif", "i.TIFF", "j.webp", "/x.y/z.png"})
+  for (const char* yes : {"a.jpg", "b.JPEG", "c.png", "d.Bmp", "e.pgm", "f.ppm", "g.pnm", "h.tif",
+                          "i.TIFF", "j.webp", "/x.y/z.png"})
     EXPECT_TRUE(isImageFileName(yes)) << yes;
   for (const char* no : {"a.txt", "b", "c.jpg.part", ".png/x", "d.gif", "e.json", "png"})
     EXPECT_FALSE(isImageFileName(no)) << no;

@@ -52,11 +52,10 @@ TEST(Registry, UnknownSchemeNamesItAndTheKnownOnes) {
 // abbreviated or misspelt is named.
 TEST(Registry, UnknownUriParameterIsRefusedBeforeTheFactoryRuns) {
   int made = 0;
-  Registry::instance().addRange(
-      "bare", [&made](const Uri&, DeviceContext&) {
-        ++made;
-        return std::make_unique<NullRange>();
-      });
+  Registry::instance().addRange("bare", [&made](const Uri&, DeviceContext&) {
+    ++made;
+    return std::make_unique<NullRange>();
+  });
   Registry::instance().addRange(
       "open", [](const Uri&, DeviceContext&) { return std::make_unique<NullRange>(); },
       {Registry::kAnyParameter});

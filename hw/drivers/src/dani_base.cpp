@@ -19,12 +19,13 @@ using proto::Message;
 using proto::Type;
 
 void DaniParams::validate() const {
-  require(link_timeout_s > 0 && link_timeout_s <= 5, "dani.link_timeout_s", "must be in (0, 5] s");
+  require(link_timeout_s > 0 && link_timeout_s <= 5, "base.dani.link_timeout_s",
+          "must be in (0, 5] s");
   require(heartbeat_period_s > 0 && heartbeat_period_s < link_timeout_s * 10,
-          "dani.heartbeat_period_s", "must be positive");
-  require(hello_period_s > 0, "dani.hello_period_s", "must be positive");
-  require(connect_timeout_s > 0 && connect_timeout_s <= kMaxConnectTimeoutS, "dani.connect_timeout_s",
-          "must be in (0, 60] s");
+          "base.dani.heartbeat_period_s", "must be positive");
+  require(hello_period_s > 0, "base.dani.hello_period_s", "must be positive");
+  require(connect_timeout_s > 0 && connect_timeout_s <= kMaxConnectTimeoutS,
+          "base.dani.connect_timeout_s", "must be in (0, 60] s");
   static_assert(kMaxConnectTimeoutS == 60.0, "the message above states the bound");
 }
 

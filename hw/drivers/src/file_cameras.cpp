@@ -11,8 +11,8 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
-#include "sketchnav/core/log.h"
 #include "sketchnav/core/image_file.h"
+#include "sketchnav/core/log.h"
 
 namespace fs = std::filesystem;
 

@@ -431,6 +431,43 @@ TEST(Dani, RegistryOpensBaseAndSonarOverOneLinkAndFailsFastWithoutABase) {
   EXPECT_THROW(Registry::instance().createBase(uri + "?secret_file=" + secret, ctx2), InputError);
 }
 
+// Issue 28: ?secret_file=/dev/zero grew past 2 GB in 5 s, connect_timeout_s=1e308 hung the run.
+// Both are refused before the link is opened, with the parameter or file named.
+TEST(Dani, SecretFileAndConnectTimeoutAreBoundedBeforeUse) {
+  registerDrivers();
+  DeviceContext ctx;
+  const std::string base = "dani://127.0.0.1:9";  // nothing is contacted: refused before
+  auto error = [&](const std::string& uri) -> std::string {
+    try {
+      Registry::instance().createBase(uri, ctx);
+    } catch (const InputError& e) {
+      return e.what();
+    } catch (const std::exception& e) {
+      return std::string("other: ") + e.what();
+    }
+    return "";
+  };
+  std::string e = error(base + "?secret_file=/dev/zero");
+  EXPECT_NE(e.find("secret file '/dev/zero': is a character device"), std::string::npos) << e;
+  const std::string dir = test::tempDir("dani-bounds");
+  {
+    std::ofstream big(dir + "/big");
+    big << std::string(kMaxSecretFileBytes + 1, 'k');
+  }
+  e = error(base + "?secret_file=" + dir + "/big");
+  EXPECT_NE(e.find("too large (4097 bytes > 4096)"), std::string::npos) << e;
+  e = error(base + "?secret_file=" + dir);
+  EXPECT_NE(e.find("is a directory"), std::string::npos) << e;
+  for (const char* t : {"1e308", "61", "nan", "0", "-1"}) {
+    e = error(base + "?connect_timeout_s=" + t);
+    EXPECT_NE(e.find("'base.dani.connect_timeout_s': must be in (0, 60] s"), std::string::npos)
+        << t << ": " << e;
+  }
+  ctx.config.set("base.dani.connect_timeout_s=1e308");
+  e = error(base);
+  EXPECT_NE(e.find("'base.dani.connect_timeout_s': must be in (0, 60] s"), std::string::npos) << e;
+}
+
 namespace {
 /// A hand-driven base: answers the link's Hello with a chosen Welcome and sends chosen
 /// stream messages, recording what the laptop sends.

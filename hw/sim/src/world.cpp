@@ -401,8 +401,7 @@ World worldFromJson(const Json& j, const std::string& origin, const std::string&
     it.check(l.min_range >= 0, "min_range", "must be >= 0");
     it.check(l.max_range > l.min_range, "max_range", "must be > min_range");
     it.check(l.noise_std >= 0, "noise_std", "must be >= 0");
-    it.check(l.rate_hz > 0 && l.rate_hz <= kMaxRangeRateHz, "rate_hz",
-             "must be in (0, 100] Hz");
+    it.check(l.rate_hz > 0 && l.rate_hz <= kMaxRangeRateHz, "rate_hz", "must be in (0, 100] Hz");
     static_assert(kMaxRangeRateHz == 100.0, "the message states the bound");
   }
   bool sonar_beams_given = false;
@@ -432,8 +431,7 @@ World worldFromJson(const Json& j, const std::string& origin, const std::string&
     it.check(so.min_range >= 0, "min_range", "must be >= 0");
     it.check(so.max_range > so.min_range, "max_range", "must be > min_range");
     it.check(so.noise_std >= 0, "noise_std", "must be >= 0");
-    it.check(so.rate_hz > 0 && so.rate_hz <= kMaxRangeRateHz, "rate_hz",
-             "must be in (0, 100] Hz");
+    it.check(so.rate_hz > 0 && so.rate_hz <= kMaxRangeRateHz, "rate_hz", "must be in (0, 100] Hz");
     static_assert(kMaxRangeRateHz == 100.0, "the message states the bound");
   }
   if (const Json* s = r.child("robot")) {

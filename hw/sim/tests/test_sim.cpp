@@ -217,6 +217,21 @@ TEST(WorldValidation, OtherBadFields) {
   EXPECT_NE(e.find("w.world.json"), std::string::npos);
 }
 
+// Issue 28: laser.rate_hz = 1e9 made `sim drive` take > 40 s; a range sensor's rate is bounded.
+TEST(WorldValidation, RangeSensorRatesHaveAnUpperBound) {
+  for (const char* sensor : {"laser", "sonar"}) {
+    Json j = minimalWorldJson();
+    j[sensor] = {{"rate_hz", 1e9}};
+    const std::string e = loadError(j);
+    EXPECT_NE(e.find(std::string(sensor) + ".rate_hz: must be in (0, 100] Hz"), std::string::npos)
+        << e;
+    j[sensor] = {{"rate_hz", sim::kMaxRangeRateHz}};
+    EXPECT_EQ(loadError(j), "") << sensor;
+    j[sensor] = {{"rate_hz", 0}};
+    EXPECT_NE(loadError(j).find(std::string(sensor) + ".rate_hz"), std::string::npos);
+  }
+}
+
 TEST(WorldValidation, InvalidJsonAndMissingFile) {
   EXPECT_THROW(sim::loadWorld("/nonexistent/x.world.json"), InputError);
   const std::string dir = test::tempDir("badjson");

@@ -40,8 +40,7 @@ enum class ImageMode {
 /// probed and its dimensions bounded before anything is decoded). `name` starts each message,
 /// e.g. "image 'a.jpg'". Never returns an empty Mat.
 cv::Mat decodeImage(const std::string& bytes, const std::string& name,
-                    ImageMode mode = ImageMode::Colour,
-                    std::uint64_t max_pixels = kMaxImagePixels);
+                    ImageMode mode = ImageMode::Colour, std::uint64_t max_pixels = kMaxImagePixels);
 
 /// Reads and decodes an image file. Every problem is an InputError "<what> '<path>': ...":
 /// not a regular file, larger than `max_bytes`, not a supported image format, a header that

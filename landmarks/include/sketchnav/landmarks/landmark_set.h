@@ -19,10 +19,10 @@ struct LandmarkSet {
   std::vector<std::string> skipped;    // files / folders ignored, with the reason
 };
 
-/// Scans `root`. Files that are not images (sketchnav::isImageFileName) and empty leaf folders are listed in `skipped`
-/// (and logged); whether a photo decodes is checked later, when it is read. Throws
-/// InputError naming `root` when it is not a folder or holds no photos at all. A root without
-/// sub-folders is one class named after it.
+/// Scans `root`. Files that are not images (sketchnav::isImageFileName) and empty leaf folders are
+/// listed in `skipped` (and logged); whether a photo decodes is checked later, when it is read.
+/// Throws InputError naming `root` when it is not a folder or holds no photos at all. A root
+/// without sub-folders is one class named after it.
 LandmarkSet scanLandmarkSet(const std::string& root);
 
 /// Leaf class name of an image path inside a landmark set (its parent folder's name).

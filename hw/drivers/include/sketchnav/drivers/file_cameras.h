@@ -66,7 +66,8 @@ class VideoCamera final : public Camera {
   DeviceStats stats_;
 };
 
-/// Image files (sketchnav::isImageFileName) directly inside `dir`, in natural order ("frame2" before "frame10").
+/// Image files (sketchnav::isImageFileName) directly inside `dir`, in natural order ("frame2"
+/// before "frame10").
 std::vector<std::string> listImages(const std::string& dir);
 
 }  // namespace sketchnav::drivers
