@@ -44,6 +44,9 @@ if(SKETCHNAV_NODE)
       --sketchnav $<TARGET_FILE:sketchnav>
       --out ${CMAKE_CURRENT_BINARY_DIR}/browser-features
       --model-cache ${PROJECT_BINARY_DIR}/model-cache)
+  # Alone on the machine: it draws with the mouse in real time and runs a real-time simulated
+  # run; beside the closed-loop tests on two cores its pointer events and the run lag (seen:
+  # a traced path read at 70 instead of 90 px/m).
   set_tests_properties(browser_ui_features PROPERTIES TIMEOUT 400 LABELS "ui;browser"
-    SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
+    RUN_SERIAL TRUE SKIP_RETURN_CODE 77 ENVIRONMENT "SKETCHNAV_SHARE=${PROJECT_SOURCE_DIR}/share")
 endif()
