@@ -12,7 +12,10 @@
 #include <sstream>
 
 #include "server.h"
+#include <opencv2/imgcodecs.hpp>
+
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 // clang-format on
 
@@ -68,13 +71,8 @@ std::string percentEncode(const std::string& s) {
 // first image by name.
 fs::path thumbnailOf(const fs::path& class_dir) {
   std::vector<fs::path> images;
-  for (const auto& f : fs::directory_iterator(class_dir)) {
-    std::string ext = f.path().extension().string();
-    std::transform(ext.begin(), ext.end(), ext.begin(),
-                   [](unsigned char c) { return std::tolower(c); });
-    if (f.is_regular_file() && (ext == ".jpg" || ext == ".jpeg" || ext == ".png"))
-      images.push_back(f.path());
-  }
+  for (const auto& f : fs::directory_iterator(class_dir))
+    if (f.is_regular_file() && isImageFileName(f.path().string())) images.push_back(f.path());
   std::sort(images.begin(), images.end());
   for (const auto& p : images)
     if (p.filename().string().find("Iconic") != std::string::npos) return p;
@@ -151,7 +149,16 @@ void addEditorRoutes(Server& server, const EditorOptions& o) {
                const fs::path img = thumbnailOf(fs::path(o.landmarks_dir) / name);
                if (img.empty()) return sendError(res, 404, "class '" + name + "' has no image");
                std::string ext = img.extension().string();
-               res.set_content(readFile(img), ext == ".png" ? "image/png" : "image/jpeg");
+               std::transform(ext.begin(), ext.end(), ext.begin(),
+                              [](unsigned char c) { return std::tolower(c); });
+               if (ext == ".png" || ext == ".jpg" || ext == ".jpeg") {
+                 res.set_content(readFile(img), ext == ".png" ? "image/png" : "image/jpeg");
+               } else {
+                 // A format a browser may not show (TIFF, PGM, ...): sent as JPEG.
+                 std::vector<uchar> jpg;
+                 cv::imencode(".jpg", readImageFile(img.string(), "thumbnail"), jpg);
+                 res.set_content(std::string(jpg.begin(), jpg.end()), "image/jpeg");
+               }
                res.set_header("Cache-Control", "max-age=3600");
              });
 

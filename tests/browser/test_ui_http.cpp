@@ -10,6 +10,8 @@
 #include <fstream>
 #include <thread>
 
+#include <opencv2/imgcodecs.hpp>
+
 #include "server.h"
 #include "test_data.h"
 // clang-format on
@@ -249,6 +251,35 @@ TEST(UiHttpClasses, ClassNamesWithSpacesAndSymbolsGetWorkingThumbnailUrls) {
   r = cli.Get("/api/sketches");  // no examples directory: an empty list, not an error
   ASSERT_TRUE(r);
   EXPECT_EQ(Json::parse(r->body)["examples"], Json::array());
+  server.stop();
+  t.join();
+}
+
+// Landmark sets may hold any image format the loaders read (isImageFileName); a browser may not
+// show a BMP or TIFF, so such a thumbnail is sent as JPEG.
+TEST(UiClasses, ThumbnailOfAClassWithOnlyABmpIsSentAsJpeg) {
+  const std::string dir = test::tempDir("uibmp");
+  fs::create_directories(dir + "/set/Boxy");
+  const cv::Mat img(40, 30, CV_8UC3, cv::Scalar(10, 200, 30));
+  ASSERT_TRUE(cv::imwrite(dir + "/set/Boxy/a.bmp", img));
+  ui::ServerOptions so;
+  so.port = 0;
+  ui::Server server(so);
+  ui::addEditorRoutes(server, {dir + "/set", dir + "/sketches", ""});
+  const int port = server.bind();
+  std::thread t([&] { server.serve(); });
+  httplib::Client cli("127.0.0.1", port);
+  auto r = cli.Get("/api/classes");
+  ASSERT_TRUE(r);
+  ASSERT_EQ(Json::parse(r->body)["classes"].size(), 1u);
+  r = cli.Get("/api/classes/Boxy/thumbnail");
+  ASSERT_TRUE(r);
+  EXPECT_EQ(r->status, 200);
+  EXPECT_EQ(r->get_header_value("Content-Type"), "image/jpeg");
+  const cv::Mat back = cv::imdecode(std::vector<uchar>(r->body.begin(), r->body.end()),
+                                    cv::IMREAD_COLOR);
+  ASSERT_FALSE(back.empty());
+  EXPECT_EQ(back.size(), img.size());
   server.stop();
   t.join();
 }
