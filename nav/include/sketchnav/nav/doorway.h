@@ -47,7 +47,6 @@ struct GoalDoorParams : DoorwayParams {
   bool enabled = true;    // false: a doorway goal is a drawn point like any other
   double look_m = 4.0;    // [m] look while the sketch's goal is this close to the robot
   double search_m = 1.5;  // [m] how far off the sketch's goal a doorway's stopping point may be
-                          // (the exp3-4 sketches: 0.5-0.8 m off in the trials that missed)
   int min_scans = 3;      // sightings that must agree before the goal moves
   double agree_m = 0.2;   // [m]
   template <class B>

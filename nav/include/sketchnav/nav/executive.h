@@ -56,24 +56,19 @@ struct ExecutiveParams {
   // scale and position are refitted by least squares to the last fit_fixes of them
   // (SectionTracker::fitSimilarityWeighted), then shifted fit_local_gain of the way to the
   // newest; before that, realign/reanchor below. 0 fixes = always realign/reanchor.
-  // All fixes, no local shift: each drawn box is off on its own (the experiments' sketch
-  // noise), so every fix is worth the same to the fit wherever it is, and pulling the route
-  // to the newest only adds that box's error. Over the fixes recorded in 74 experiment trials
-  // (offline refit), the final goal error was over 0.5 m in 11 with the last 4 fixes, a 30 %
-  // local shift and a 0.6 m outlier gate, and in 4 with all fixes, none and 0.9 m. A sketch
-  // distorted smoothly (one room drawn too small) would want fewer fixes and a local shift.
+  // All fixes, no local shift: each drawn box is off on its own, so every fix is worth the
+  // same to the fit wherever it is, and pulling the route to the newest only adds that box's
+  // error. A sketch distorted smoothly (one room drawn too small) would want fewer fixes and
+  // a local shift. Evidence: doc/navigation.md "Evidence for the defaults".
   int fit_fixes = 100;
   double fit_min_span_m = 5.0;         // [m]
   double fit_max_scale_change = 0.5;  // relative to the drawing's own scale, over all fits
   double fit_local_gain = 0.0;
   // The start stays in every fit: it is where the user put the robot, and it gives the fit a
-  // baseline as long as the route. Fitting only the last fit_fixes landmarks (5-7 m apart)
-  // let the scale swing 10-15 % per fit and put the goal 0.5-1 m off (the experiments'
-  // "stopped short of the goal": about 10 of 52 trials without it, 3 of 52 with it).
+  // baseline as long as the route (fitting only the newest landmarks lets the scale swing).
   bool fit_keep_start = true;
-  // [m] a fix this far off the others' fit (Mahalanobis x the sketch's 0.3 m) is left out.
-  // 0.6 m (2 sigma) left out one in seven good fixes, and with 4-6 of them the rest then
-  // turned the route: an exp3-4 robot, L7 triangulated to 0.1 m, stopped 0.92 m short.
+  // [m] a fix this far off the others' fit (Mahalanobis x the sketch's 0.3 m) is left out;
+  // too tight a gate leaves good fixes out and the rest turn the route.
   double fit_outlier_m = 0.9;
   // A landmark seen only from afar or from one place without a usable range still counts:
   // its rays place it across them (locateLandmark: bearing_only), which turns the route.

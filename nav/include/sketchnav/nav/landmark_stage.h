@@ -20,18 +20,14 @@ struct SelectParams {
   double bearing_sigma_deg = 10;  // [deg] scale of the bearing term in the cost
   double range_sigma_m = 1.0;     // [m] scale of the range term
   // A detection whose measured range fails the range gate is still taken, as a bearing
-  // without a range, when its bearing is within this of the prediction: the laser passes
-  // under or beside a landmark standing on a table or shelf and reads what is behind it
-  // (exp3-4 seed 22: the last landmark recognised in 32 frames at its predicted bearing,
-  // laser 7.5 m vs 4.6 m predicted, every one refused, the landmark missed and the goal
-  // 0.83 m off). It costs as much as a range at the gate's edge, so a detection whose range
-  // agrees wins. 0 = refuse such detections.
+  // without a range, when its bearing is within this of the prediction [deg]: the laser passes
+  // under or beside a landmark standing on a table or shelf and reads what is behind it. It
+  // costs as much as a range at the gate's edge, so a detection whose range agrees wins.
+  // 0 = refuse such detections. Evidence: doc/navigation.md "Evidence for the defaults".
   double bearing_only_gate_deg = 10;
   // For a landmark whose class the sketch has once, that rule covers the whole bearing gate:
   // no other landmark can be mistaken for it, and a refit on the landmarks before it can put
-  // it 2 m off (exp3-4 seed 30: L7 recognised in 18 frames 26-44 deg from its predicted
-  // bearing, at about twice its predicted range, every one refused, L7 missed, the robot
-  // stopped 0.91 m from the goal).
+  // it metres off its sketched place. Evidence: doc/navigation.md "Evidence for the defaults".
   bool unique_class_bearing_only = true;
   template <class B>
   void bind(B& b) {

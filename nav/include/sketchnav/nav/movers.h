@@ -23,12 +23,11 @@ namespace sketchnav::nav {
 class LocalPlanner;
 
 struct MoverParams {
-  // Keeping out of every mover's lane (advise()) is off by default: in the lab the tracker
-  // still reports phantom movers (occlusion edges of small furniture while the robot drives:
-  // 2-8 lane events per run where nobody walks), and yielding to them changed closed-loop runs
-  // for the worse (lab seed 1 "lost", the pedestrian-right trial it was made for still
-  // collided). `--set nav.movers.enabled=true`. The tracking itself always runs: the avoider
-  // steps out of the lane of a mover coming at the robot (avoidance.h).
+  // Keeping out of every mover's lane (advise()) is off by default: the tracker also reports
+  // phantom movers (occlusion edges of small furniture while the robot drives), and yielding
+  // to them makes closed-loop runs worse. `--set nav.movers.enabled=true`. The tracking
+  // itself always runs: the avoider steps out of the lane of a mover coming at the robot
+  // (avoidance.h). Evidence: doc/navigation.md "Evidence for the defaults".
   bool enabled = false;
   double cluster_gap_m = 0.15;   // [m] consecutive beams further apart start a new cluster
   double max_width_m = 0.8;      // [m] wider clusters are furniture or walls

@@ -106,10 +106,9 @@ struct PerceptionParams {
   double camera_pitch = 0;   // [rad] camera tilt, up positive (for Detection::elevation)
   double merge_iou = 0.3;    // detections of a class overlapping more are one landmark
   // SIFT settings for camera frames (the model's photo settings are 400 px / 500 keypoints).
-  // Describing 640 px frames at full size with 1500 keypoints roughly doubles the inliers on
-  // small, distant landmarks (lab: Bravo at 3 m 13 -> 19, at 1.7 m oblique 0 -> 12) but changes
-  // closed-loop timing enough that the hall integration run stops 0.51 m from its 0.5 m goal,
-  // so the default keeps the model's settings; raise both for small or distant landmarks.
+  // Larger frames find small, distant landmarks more often but bring back false reports of
+  // sibling products and cost time; raise both for small or distant landmarks. The evidence:
+  // doc/perception-benchmark.md "View synthesis and frame resolution".
   int frame_max_side = 400;      // [px] longer frame side above this is downscaled for SIFT
   int frame_max_features = 500;  // strongest keypoints kept per frame (0 = all)
   // Foveal second look (observe() with LookFor hints only): for a hinted class the normal pass
@@ -117,16 +116,15 @@ struct PerceptionParams {
   // full-resolution frame centred on the predicted column is matched on its own, upscaled by
   // range / fovea_ref_range_m so a distant landmark has as many pixels as a near one. Same
   // min_inliers rule: never a guess. Costs time only when a hinted landmark was missed. The
-  // crop is narrowish: less clutter competes with the landmark for the keypoint budget (lab,
-  // 2-6 m, head-on and 40 deg off: 0.3 / 0.4 / 0.5 of the frame wide found 26 / 22 / 20 of
-  // the 80 landmarks the normal pass missed), but 0.4 still finds as many with the hint 10 deg
-  // off (0.3: none). It is centred vertically, fovea_height of the frame tall, taller for a
-  // landmark nearer than 2 x fovea_ref_range_m (frame height / upscale), which may be seen
-  // well above or below the centre. doc/landmark-model.md "Foveal second look".
+  // crop is narrowish (less clutter competes with the landmark for the keypoint budget) but
+  // wide enough to hold a landmark whose predicted bearing is some degrees off. It is centred
+  // vertically, fovea_height of the frame tall, taller for a landmark nearer than
+  // 2 x fovea_ref_range_m (frame height / upscale), which may be seen well above or below the
+  // centre. doc/landmark-model.md "Foveal second look"; the evidence for the defaults:
+  // doc/perception-benchmark.md "Evidence for the foveal second-look defaults".
   bool fovea = true;               // take the second look at all
   double fovea_min_range_m = 0;    // [m] no second look at landmarks predicted nearer
-  double fovea_max_range_m = 6;    // [m] nor further (too few pixels even upscaled; lab: 1
-                                   //     of 16 found at 6 m)
+  double fovea_max_range_m = 6;    // [m] nor further (too few pixels even upscaled)
   double fovea_width = 0.4;        // crop width, fraction of the frame width, (0, 1]
   double fovea_height = 0.5;       // least crop height, fraction of the frame height, (0, 1]
   double fovea_ref_range_m = 2.0;  // [m] crop upscale = predicted range / this (at least 1)
