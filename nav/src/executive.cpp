@@ -139,6 +139,9 @@ json ExecutiveSummary::toJson() const {
             {"aligned", laser_odometry.aligned},
             {"rejected", laser_odometry.rejected},
             {"keyframes", laser_odometry.keyframes},
+            {"degenerate", laser_odometry.degenerate},
+            {"wheel_disagree", laser_odometry.wheel_disagree},
+            {"moving_share", laser_odometry.moving_share},
             {"ms_mean", laser_odometry.ms_mean}}}};
 }
 

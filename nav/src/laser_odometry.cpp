@@ -34,6 +34,11 @@ void LaserOdometryParams::validate() const {
   require(match_deg >= 0, "nav.laser_odometry.match_deg", "must be >= 0");
   require(constrained_points >= 0, "nav.laser_odometry.constrained_points", "must be >= 0");
   require(normal_radius_m > 0, "nav.laser_odometry.normal_radius_m", "must be > 0");
+  require(moving_baseline_s >= 0 && moving_baseline_s <= 5, "nav.laser_odometry.moving_baseline_s",
+          "must be in [0, 5]");
+  require(wheel_agree_m >= 0, "nav.laser_odometry.wheel_agree_m", "must be >= 0");
+  require(wheel_agree_rel >= 0 && wheel_agree_rel <= 1, "nav.laser_odometry.wheel_agree_rel",
+          "must be in [0, 1]");
 }
 
 namespace {
@@ -77,6 +82,93 @@ Eigen::Matrix2d surfaceInformation(const mrpt::aligned_std_vector<float>& xs,
   }
   return H;
 }
+
+// Range of `scan`'s beam towards robot-frame bearing `bearing` (from the mount): NaN outside
+// its field of view, +inf where it saw nothing within `rmax`.
+double rangeToward(const hw::RangeScan& scan, double bearing, double rmax) {
+  const size_t n = std::min(scan.angles.size(), scan.ranges.size());
+  if (n < 2) return std::nan("");
+  const double a0 = scan.angles.front(), step = (scan.angles.back() - a0) / (n - 1);
+  if (!(step > 0)) return std::nan("");  // beams are ordered counter-clockwise
+  double d = wrapAngle(bearing - a0);
+  if (d < 0) d += 2 * M_PI;  // a field of view may span more than half a turn
+  const double k = std::round(d / step);
+  if (!(k >= 0 && k <= static_cast<double>(n - 1))) return std::nan("");
+  const double r = scan.ranges[static_cast<size_t>(k)];
+  return std::isfinite(r) && r < rmax && r >= scan.min_range ? r : INFINITY;
+}
+
+// The points of `cur` (from scan `cs`) left once what moved since scan `rs` (points `ref`) is
+// taken out; `rel` is the current pose in the reference scan's frame. A point is explained
+// when the reference has a point, or a segment between two beam neighbours, within
+// dist + ang x range (segments because a wall seen at a grazing angle is sampled metres apart;
+// a segment longer than a fifth of its range joins two surfaces, not one). An unexplained
+// point has moved when the reference looked through the place (its beam there reached
+// further), or when what hid it then has gone (the current beam reaches past it): a person
+// walking away hides their own new place. Otherwise it has just come into view from behind
+// something still there, or into the field of view, and is kept. Runs of fewer than min_run
+// such beams are kept too: an edge sampled differently, or noise, and edges are what pin a
+// pose down.
+mrpt::maps::CSimplePointsMap movedPointsLeftOut(const mrpt::maps::CSimplePointsMap& cur,
+                                                const hw::RangeScan& cs,
+                                                const mrpt::maps::CSimplePointsMap& ref,
+                                                const hw::RangeScan& rs, const CPose2D& rel,
+                                                double dist, double ang, int min_run, double rmax) {
+  mrpt::maps::CSimplePointsMap out;
+  const auto& cx = cur.getPointsBufferRef_x();
+  const auto& cy = cur.getPointsBufferRef_y();
+  if (ref.size() == 0) return cur;
+  const auto& rx = ref.getPointsBufferRef_x();
+  const auto& ry = ref.getPointsBufferRef_y();
+  const double c = std::cos(rel.phi()), sn = std::sin(rel.phi());
+  const auto toSegment = [&](double px, double py, size_t a, size_t b) {
+    const double ax = rx[a], ay = ry[a], ex = rx[b] - ax, ey = ry[b] - ay;
+    const double len2 = ex * ex + ey * ey;
+    if (len2 > 0.04 * (ax * ax + ay * ay)) return 1e9;
+    const double u = len2 > 0 ? std::clamp(((px - ax) * ex + (py - ay) * ey) / len2, 0.0, 1.0) : 0;
+    return std::hypot(px - ax - u * ex, py - ay - u * ey);
+  };
+  const double mx = cs.mount.x, my = cs.mount.y;
+  std::vector<char> moved(cx.size(), 0);
+  for (size_t i = 0; i < cx.size(); ++i) {
+    const double px = rel.x() + c * cx[i] - sn * cy[i], py = rel.y() + sn * cx[i] + c * cy[i];
+    const double range = std::hypot(cx[i] - mx, cy[i] - my);
+    const double tol = dist + ang * range;
+    float d2 = 0;
+    const size_t j = ref.kdTreeClosestPoint2D(static_cast<float>(px), static_cast<float>(py), d2);
+    double best = std::sqrt(d2);
+    if (j > 0) best = std::min(best, toSegment(px, py, j - 1, j));
+    if (j + 1 < rx.size()) best = std::min(best, toSegment(px, py, j, j + 1));
+    if (best <= tol) continue;
+    // Seen from the reference pose: the point's range and that beam's.
+    const double rr = std::hypot(px - mx, py - my);
+    const double rref = rangeToward(rs, std::atan2(py - my, px - mx), rmax);
+    if (std::isnan(rref)) continue;  // outside the reference's field of view
+    if (rref > rr + tol) {
+      moved[i] = 1;  // the reference saw through this place
+      continue;
+    }
+    if (rref < rr - tol) {
+      // Hidden then, by a surface at rref along that beam: is it still there?
+      const double b = std::atan2(py - my, px - mx);
+      const double ox = mx + rref * std::cos(b), oy = my + rref * std::sin(b);
+      // ...that surface point in the current frame (inverse of rel)
+      const double dx = ox - rel.x(), dy = oy - rel.y();
+      const double qx = c * dx + sn * dy, qy = -sn * dx + c * dy;
+      const double rq = std::hypot(qx - mx, qy - my);
+      const double rcur = rangeToward(cs, std::atan2(qy - my, qx - mx), rmax);
+      if (!std::isnan(rcur) && rcur > rq + dist + ang * rq) moved[i] = 1;  // gone
+    }
+  }
+  for (size_t i = 0; i < cx.size();) {
+    size_t e = i;
+    while (e < cx.size() && moved[e] == moved[i]) ++e;
+    if (!moved[i] || e - i < static_cast<size_t>(min_run))
+      for (size_t k = i; k < e; ++k) out.insertPoint(cx[k], cy[k], 0.f);
+    i = e;
+  }
+  return out;
+}
 }  // namespace
 
 struct LaserOdometry::Impl {
@@ -90,12 +182,24 @@ struct LaserOdometry::Impl {
   CPose2D anchor_wheel, anchor_pose;  // a wheel pose and the corrected pose at that moment
   bool have_kf = false;
   CPose2D kf_pose;                      // the newest keyframe's pose
+  CPose2D kf_wheel;                     // the wheel pose at that moment
   mrpt::maps::CSimplePointsMap kf_map;  // the last keyframes' points, in the newest's frame
   struct Keyframe {
     CPose2D pose;
     std::vector<float> xs, ys;  // scan points in the robot frame at `pose`
   };
   std::deque<Keyframe> keyframes;  // the submap, oldest first
+  // Recent scans, every point (robot frame, beam order), with the wheel pose at each: what
+  // moved is judged against them.
+  struct Past {
+    double t;
+    CPose2D wheel;
+    mrpt::maps::CSimplePointsMap map;
+    hw::RangeScan scan;
+  };
+  std::deque<Past> past;
+  double moving_sum = 0;
+  int moving_n = 0;
   double last_scan_stamp = -1e300;
   double ms_sum = 0;
 
@@ -185,6 +289,32 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
     cur.insertPoint(static_cast<float>(sc.mount.x + r * std::cos(a)),
                     static_cast<float>(sc.mount.y + r * std::sin(a)), 0.f);
   }
+  CPose2D wheel_s;
+  I.wheelAt(sc.stamp, wheel_s);
+  // `all` keeps every point for the keyframes (a point that has just come into view is what
+  // the next scans will see more of); `cur`, aligned, leaves out what moved.
+  mrpt::maps::CSimplePointsMap all;
+  if (params_.moving_baseline_s > 0 && cur.size() > 0) {
+    const Impl::Past* ref = nullptr;
+    for (auto it = I.past.rbegin(); it != I.past.rend(); ++it)
+      if (it->t <= sc.stamp - params_.moving_baseline_s) {
+        ref = &*it;
+        break;
+      }
+    Impl::Past now{sc.stamp, wheel_s, cur, sc};
+    all = cur;
+    if (ref) {
+      cur = movedPointsLeftOut(cur, sc, ref->map, ref->scan, wheel_s - ref->wheel,
+                               params_.match_dist_m, params_.match_deg * M_PI / 180, 3, rmax);
+      I.moving_sum += 1.0 - static_cast<double>(cur.size()) / now.map.size();
+      stats_.moving_share = I.moving_sum / ++I.moving_n;
+    }
+    I.past.push_back(std::move(now));
+    // Keep the newest scan at least moving_baseline_s old, and what is newer.
+    while (I.past.size() > 1 && I.past[1].t <= sc.stamp - params_.moving_baseline_s)
+      I.past.pop_front();
+  }
+  if (all.size() == 0) all = cur;
   if (static_cast<int>(cur.size()) < params_.min_points) return;
   {
     // Spread of the points across their main axis (smaller eigenvalue of their covariance).
@@ -206,17 +336,16 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
     }
   }
 
-  CPose2D wheel_s;
-  I.wheelAt(sc.stamp, wheel_s);
   const CPose2D predicted = I.corrected(wheel_s);
   // The reference is the union of the last submap_keyframes keyframes, expressed in the newest
   // one's frame: a new keyframe is then placed against points seen from several earlier poses
   // rather than one, so its error is not simply added to the previous keyframe's.
   auto newKeyframe = [&](const CPose2D& at) {
+    I.kf_wheel = wheel_s;
     Impl::Keyframe k;
     k.pose = at;
-    k.xs.assign(cur.getPointsBufferRef_x().begin(), cur.getPointsBufferRef_x().end());
-    k.ys.assign(cur.getPointsBufferRef_y().begin(), cur.getPointsBufferRef_y().end());
+    k.xs.assign(all.getPointsBufferRef_x().begin(), all.getPointsBufferRef_x().end());
+    k.ys.assign(all.getPointsBufferRef_y().begin(), all.getPointsBufferRef_y().end());
     I.keyframes.push_back(std::move(k));
     while (static_cast<int>(I.keyframes.size()) > params_.submap_keyframes) I.keyframes.pop_front();
     I.kf_pose = at;
@@ -268,6 +397,17 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
     }
     est = CPose2D(t.x(), t.y(), est.phi());
   }
+  // The wheels' motion since the keyframe, in the robot's frame at the keyframe (as est is).
+  bool wheel_translation = false;
+  if (params_.wheel_agree_rel > 0) {
+    const CPose2D wrel = wheel_s - I.kf_wheel;
+    const double tol =
+        params_.wheel_agree_m + params_.wheel_agree_rel * std::hypot(wrel.x(), wrel.y());
+    if (std::hypot(est.x() - wrel.x(), est.y() - wrel.y()) > tol) {
+      wheel_translation = true;
+      est = CPose2D(wrel.x(), wrel.y(), est.phi());
+    }
+  }
   const CPose2D diff = est - guess;
   // How much of the scan the reference explains at the result: the share of its points with a
   // reference point within match_dist_m + match_deg * range. Not ICP's own goodness, which is
@@ -295,6 +435,7 @@ void LaserOdometry::scan(const hw::RangeScan& sc) {
   if (ok) {
     ++stats_.aligned;
     if (degenerate) ++stats_.degenerate;
+    if (wheel_translation) ++stats_.wheel_disagree;
     now_pose = I.kf_pose + est;
     I.anchor_wheel = wheel_s;
     I.anchor_pose = now_pose;

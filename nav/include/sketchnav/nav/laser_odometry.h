@@ -35,6 +35,14 @@
 // eigen-directions with fewer than constrained_points points' worth of normals the wheels'
 // increment is kept, ICP's correction across it and in heading (same test: 0.60 m off, the
 // wheels' own 0.61). Walls and furniture facing every way (a room) leave ICP's result whole.
+//
+// What the scan does pin down must also be still: a person walking ahead along a corridor is
+// often the only surface facing along it, and aligned to them the robot stands still with
+// them (in a simulated corridor run, 0.3 m of 3 m counted). Points that moved since a scan a
+// moment ago, the two placed by the wheels, are left out (moving_baseline_s); and since the
+// keyframe, the alignment's translation must agree with the wheels' within what an encoder
+// gets wrong (wheel_agree_*), or the wheels' translation is kept: a slow walker passes the
+// first check but not, over a keyframe's length, the second.
 #include <deque>
 #include <memory>
 
@@ -66,6 +74,21 @@ struct LaserOdometryParams {
                                    // takes the wheels' increment, not ICP's; from twice this
                                    // ICP's is taken whole, blended in between. 0: always ICP's
   double normal_radius_m = 0.3;    // [m] neighbours a point's surface normal is fitted to
+  // The alignment's translation since the keyframe may differ from the wheels' by at most
+  // wheel_agree_m + wheel_agree_rel x the wheels' travel since it; beyond that the wheels'
+  // translation is kept (ICP's heading still taken). A wheel encoder is off by a few percent
+  // of the distance, a scan aligned to something that moves (a person walking along with the
+  // robot, or towards it) by the distance itself. Wheels that slip without the robot moving
+  // (pushing against an obstacle) would pass this check the other way; the avoider keeps the
+  // robot off obstacles. wheel_agree_rel = 0: no check.
+  // Points that moved are left out of the alignment and of the keyframes: the current scan is
+  // placed in the scan of moving_baseline_s ago by the wheels' motion since (good to a few mm
+  // over so short a time) and a point with no surface of that scan within match_dist_m +
+  // match_deg x range moved, or has just come into view. Things slower than about
+  // (match_dist_m + match_deg x range) / moving_baseline_s pass as still. 0: keep every point.
+  double moving_baseline_s = 0.5;  // [s]
+  double wheel_agree_m = 0.05;     // [m]
+  double wheel_agree_rel = 0.15;   // fraction of the wheels' travel since the keyframe
   template <class B>
   void bind(B& b) {
     b("enabled", enabled);
@@ -82,6 +105,9 @@ struct LaserOdometryParams {
     b("max_correction_deg", max_correction_deg);
     b("constrained_points", constrained_points);
     b("normal_radius_m", normal_radius_m);
+    b("moving_baseline_s", moving_baseline_s);
+    b("wheel_agree_m", wheel_agree_m);
+    b("wheel_agree_rel", wheel_agree_rel);
   }
   void validate() const;  // InputError "nav.laser_odometry.<field> = ...: ..."
 };
@@ -92,8 +118,11 @@ struct LaserOdometryStats {
   int attempts = 0;  // ICP alignments run
   int rejected = 0;  // scans not used (degenerate geometry, poor match, too far from the wheels)
   int keyframes = 0;
-  int degenerate = 0;  // accepted alignments that took the wheels' increment along some axis
-  double ms_mean = 0;  // [ms] wall time per alignment
+  int degenerate = 0;       // accepted alignments that took the wheels' increment along some axis
+  double moving_share = 0;  // mean share of a scan's points left out as moved or new
+  int wheel_disagree = 0;   // accepted alignments whose translation was the wheels' (see
+                            // LaserOdometryParams::wheel_agree_rel)
+  double ms_mean = 0;       // [ms] wall time per alignment
 };
 
 class LaserOdometry {
