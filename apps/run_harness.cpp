@@ -622,6 +622,8 @@ Json runNavigation(const RunOptions& o) {
                      {"match_ms", es.match_ms_mean},
                      {"full_passes", es.full_passes},
                      {"tracked_detections", es.tracked_detections}};
+  // Loop rates over the run's clock and the wall, and the latency percentiles (nav::LoopTiming).
+  s["timing"] = ej["timing"];
   s["executive"] = {{"status", nav::toString(es.status)},
                     {"failure", nav::toString(es.failure)},
                     {"reason", es.reason}};

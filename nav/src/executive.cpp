@@ -1,6 +1,7 @@
 #include "sketchnav/nav/executive.h"
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <limits>
 
@@ -142,7 +143,32 @@ json ExecutiveSummary::toJson() const {
             {"degenerate", laser_odometry.degenerate},
             {"wheel_disagree", laser_odometry.wheel_disagree},
             {"moving_share", laser_odometry.moving_share},
-            {"ms_mean", laser_odometry.ms_mean}}}};
+            {"ms_mean", laser_odometry.ms_mean}}},
+          {"timing", timing.toJson(time_s)}};
+}
+
+json LoopTiming::toJson(double time_s) const {
+  auto rate = [&](int n) {
+    return json{{"n", n},
+                {"clock", time_s > 0 ? n / time_s : 0.0},
+                {"wall", wall_s > 0 ? n / wall_s : 0.0}};
+  };
+  return {{"time_s", time_s},
+          {"wall_s", wall_s},
+          {"rates_hz",
+           {{"camera_frames", rate(frames)},
+            {"perception_frames", rate(perception_frames)},
+            {"full_passes", rate(full_passes)},
+            {"tracked_frames", rate(tracked_frames)},
+            {"servo_updates", rate(servo_updates)},
+            {"control_ticks", rate(ticks)}}},
+          {"latency_ms",
+           {{"grab_to_command", grab_to_command_ms.toJson()},
+            {"perception", perception_ms.toJson()},
+            {"objectness", objectness_ms.toJson()},
+            {"features", features_ms.toJson()},
+            {"match", match_ms.toJson()},
+            {"track", track_ms.toJson()}}}};
 }
 
 namespace {
@@ -206,6 +232,14 @@ struct Executive::Impl {
   int frames = 0, processed = 0, manoeuvres = 0, missed_in_row = 0;
   double perc_sum = 0, perc_max = 0, objn_sum = 0, feat_sum = 0, match_sum = 0;
   int full_passes = 0, tracked_detections = 0;
+  // Loop rates and latency budget (LoopTiming): counts, and samples added as they happen
+  // (no lock: the executive runs on one thread).
+  using WallClock = std::chrono::steady_clock;
+  WallClock::time_point wall0, wall_last, grab_wall;
+  double grab_lag_ms = 0;  // [ms] run clock from the frame's stamp to the grab's return
+  int ticks = 0, tracked_frames = 0, servo_updates = 0;
+  PercentileAccumulator grab_to_command_ms, perception_ms, objectness_ms, features_ms, match_ms,
+      track_ms;
   std::vector<std::vector<LmTrack>> tracks;  // per section, per expected landmark
   servo::TurnCommand servo_cmd;
   double servo_t = -1e300, servo_bearing = 0;
@@ -405,6 +439,7 @@ struct Executive::Impl {
     }
     hw::Frame frame;
     bool have_frame = false;
+    bool perceived = false;  // perception looked at `frame` this tick
     if (dev.camera && now + 1e-9 >= frame_stamp + s.exec.camera_period_s - 0.5 * s.exec.tick_s) {
       const auto st = dev.camera->grab(frame, 0.5 * s.exec.tick_s);
       if (st == hw::GrabStatus::Ok && frame.stamp > frame_stamp && !frame.image.empty()) {
@@ -414,6 +449,10 @@ struct Executive::Impl {
         ++frames;
       }
       now = dev.clock->now();  // a simulated camera may have advanced time to its frame
+      if (have_frame) {
+        grab_wall = WallClock::now();
+        grab_lag_ms = (now - frame.stamp) * 1e3;
+      }
     }
     // --- safety ------------------------------------------------------------------------
     const auto st = safety.check(now, dev.base->ok());
@@ -550,6 +589,16 @@ struct Executive::Impl {
         ob = perception.observe(frame, K, classes);
       }
       ++processed;
+      perceived = true;
+      const PerceptionTiming& pt = ob.timing;
+      perception_ms.add(pt.total_ms);
+      if (pt.full_pass) {
+        objectness_ms.add(pt.objectness_ms);
+        features_ms.add(pt.features_ms);
+        match_ms.add(pt.match_ms);
+      }
+      if (pt.track_steps > 0) track_ms.add(pt.track_ms);
+      tracked_frames += pt.tracked > 0 ? 1 : 0;
       perc_sum += ob.timing.total_ms;
       full_passes += ob.timing.full_pass ? 1 : 0;
       tracked_detections += ob.timing.tracked;
@@ -633,6 +682,7 @@ struct Executive::Impl {
         if (n == 0) {
           const double depth = range > 0 ? range * std::cos(d.bearing) : 0;
           servo_cmd = law.compute(d.x_t, d.x_d, depth);
+          ++servo_updates;
           servo_t = now;
           servo_bearing = d.bearing;
           if (range > 0 && range <= passDistance(x.k, *x.lm)) passLandmark(x.k, x.i, true);
@@ -932,6 +982,10 @@ struct Executive::Impl {
     const double v = cmd.v;
     const double w = std::clamp(cmd.w, -s.exec.max_w, s.exec.max_w);
     dev.base->command(v, w);
+    if (perceived)
+      grab_to_command_ms.add(
+          grab_lag_ms +
+          std::chrono::duration<double, std::milli>(WallClock::now() - grab_wall).count());
     if (obs) {
       TelemetryRow row;
       row.t = now - t0;
@@ -1300,6 +1354,13 @@ void Executive::start() {
   I.fixes_info = {Eigen::Matrix2d::Identity() / (0.05 * 0.05)};  // the start: where it is put
   I.fixes_across = {Eigen::Vector2d::Zero()};
   I.safety.start(I.t0);
+  I.wall0 = I.wall_last = Impl::WallClock::now();
+  // Room for a whole run's samples up front: no reallocation inside the loop.
+  const double frames_max = I.s.exec.max_time_s / I.s.exec.camera_period_s + 1;
+  const auto n = static_cast<size_t>(std::min(frames_max, 65536.0));
+  for (auto* a : {&I.grab_to_command_ms, &I.perception_ms, &I.objectness_ms, &I.features_ms,
+                  &I.match_ms, &I.track_ms})
+    a->reserve(n);
   I.status = RunStatus::Running;
   I.event(event::Start{I.tracker.count(), I.tracker.route().total_length_m});
 }
@@ -1307,6 +1368,7 @@ void Executive::start() {
 void Executive::step() {
   auto& I = *impl_;
   if (I.status != RunStatus::Running) return;
+  ++I.ticks;
   try {
     I.tick();
   } catch (const std::exception& e) {
@@ -1317,6 +1379,7 @@ void Executive::step() {
     I.dev.base->stop();
     I.fail(FailureCode::SafetyStop, "safety stop: unknown exception");
   }
+  I.wall_last = Impl::WallClock::now();
 }
 
 void Executive::stop(const std::string& reason) {
@@ -1371,6 +1434,20 @@ ExecutiveSummary Executive::summary() const {
   s.perception_ms_max = I.perc_max;
   s.full_passes = I.full_passes;
   s.tracked_detections = I.tracked_detections;
+  LoopTiming& lt = s.timing;
+  lt.ticks = I.ticks;
+  lt.frames = I.frames;
+  lt.perception_frames = I.processed;
+  lt.full_passes = I.full_passes;
+  lt.tracked_frames = I.tracked_frames;
+  lt.servo_updates = I.servo_updates;
+  lt.wall_s = std::chrono::duration<double>(I.wall_last - I.wall0).count();
+  lt.grab_to_command_ms = I.grab_to_command_ms.summary();
+  lt.perception_ms = I.perception_ms.summary();
+  lt.objectness_ms = I.objectness_ms.summary();
+  lt.features_ms = I.features_ms.summary();
+  lt.match_ms = I.match_ms.summary();
+  lt.track_ms = I.track_ms.summary();
   s.avoidance_manoeuvres = I.manoeuvres;
   s.recoveries = I.recoveries;
   s.detours = I.detours;

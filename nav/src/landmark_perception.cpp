@@ -459,6 +459,7 @@ Observation LandmarkPerception::observeFrame(const hw::Frame& frame, const hw::I
   cv::Mat grey;
   std::vector<Detection> followed;
   double track_ms = 0;
+  int track_steps = 0;
   if (track) {
     const auto tt = clk::now();
     if (frame.image.channels() == 3)
@@ -472,7 +473,12 @@ Observation LandmarkPerception::observeFrame(const hw::Frame& frame, const hw::I
       auto& tr = it->second;
       landmarks::MatchResult m;
       const bool looked = std::find(classes.begin(), classes.end(), it->first) != classes.end();
-      if (!looked || ++tr.unconfirmed > P.track.max_unconfirmed_frames || !tr.klt.step(grey, m)) {
+      if (!looked || ++tr.unconfirmed > P.track.max_unconfirmed_frames) {
+        it = I.tracks.erase(it);
+        continue;
+      }
+      ++track_steps;
+      if (!tr.klt.step(grey, m)) {
         it = I.tracks.erase(it);
         continue;
       }
@@ -515,6 +521,7 @@ Observation LandmarkPerception::observeFrame(const hw::Frame& frame, const hw::I
     std::sort(ob.detections.begin(), ob.detections.end(),
               [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
     ob.timing.track_ms = track_ms;
+    ob.timing.track_steps = track_steps;
   }
   ob.timing.total_ms = msSince(t0);
   return ob;

@@ -90,6 +90,48 @@ TEST(Executive, ReachesTheEndWithLandmarks) {
   EXPECT_TRUE(s.world.stopped_called);
 }
 
+TEST(Executive, ReportsItsLoopRatesAndLatencyPercentiles) {
+  // Ticks at 20 Hz, the camera at 10 Hz, perception at most every 0.2 s, on a simulated clock:
+  // the counts and clock rates are exact; the fake perception costs 1 ms and runs no full pass
+  // and no tracker. No wall-time figure is checked beyond its order.
+  Scenario s;
+  const auto sum = s.run();
+  ASSERT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  const LoopTiming& t = sum.timing;
+  EXPECT_NEAR(t.ticks, sum.time_s / s.settings.exec.tick_s, 2);
+  EXPECT_EQ(t.frames, sum.frames);
+  EXPECT_NEAR(t.frames, sum.time_s / s.settings.exec.camera_period_s, 2);
+  EXPECT_EQ(t.perception_frames, sum.frames_processed);
+  EXPECT_LE(t.perception_frames, t.frames);
+  EXPECT_GT(t.perception_frames, 10);
+  EXPECT_GT(t.servo_updates, 0);  // both landmarks were servoed on
+  EXPECT_LE(t.servo_updates, t.perception_frames);
+  EXPECT_EQ(t.full_passes, 0);
+  EXPECT_EQ(t.tracked_frames, 0);
+  EXPECT_GT(t.wall_s, 0);
+  // Every frame perception looked at reached a command: the run never ended in such a tick.
+  EXPECT_EQ(t.grab_to_command_ms.n, static_cast<size_t>(t.perception_frames));
+  EXPECT_GE(t.grab_to_command_ms.p50, 0);  // the fake camera stamps its frame at the grab
+  EXPECT_LE(t.grab_to_command_ms.p50, t.grab_to_command_ms.p95);
+  EXPECT_LE(t.grab_to_command_ms.p95, t.grab_to_command_ms.p99);
+  EXPECT_LE(t.grab_to_command_ms.p99, t.grab_to_command_ms.max);
+  EXPECT_EQ(t.perception_ms.n, static_cast<size_t>(t.perception_frames));
+  EXPECT_EQ(t.perception_ms.p50, 1);
+  EXPECT_EQ(t.perception_ms.max, 1);
+  EXPECT_EQ(t.objectness_ms.n, 0u);
+  EXPECT_EQ(t.track_ms.n, 0u);
+
+  const auto j = sum.toJson()["timing"];
+  EXPECT_NEAR(j["rates_hz"]["control_ticks"]["clock"].get<double>(), 20, 0.5);
+  EXPECT_NEAR(j["rates_hz"]["camera_frames"]["clock"].get<double>(), 10, 0.5);
+  EXPECT_LE(j["rates_hz"]["perception_frames"]["clock"].get<double>(), 5 + 1e-9);
+  EXPECT_EQ(j["rates_hz"]["servo_updates"]["n"], t.servo_updates);
+  EXPECT_GT(j["rates_hz"]["servo_updates"]["wall"].get<double>(), 0);
+  EXPECT_EQ(j["latency_ms"]["perception"]["p95"], 1.0);
+  EXPECT_TRUE(j["latency_ms"]["objectness"]["p50"].is_null());  // no full pass: no figure
+  EXPECT_EQ(j["latency_ms"]["grab_to_command"]["n"], t.perception_frames);
+}
+
 TEST(Executive, ReachesTheEndWithOneLandmarkMissing) {
   Scenario s(/*see_a=*/false, /*see_b=*/true);
   const auto sum = s.run();

@@ -290,6 +290,7 @@ TEST_F(FoveaTest, TrackingServesTheFramesBetweenFullPasses) {
     EXPECT_EQ(ob.timing.full_pass, i % 3 == 0) << "frame " << i;
     EXPECT_EQ(d.tracked, !ob.timing.full_pass) << "frame " << i;
     EXPECT_EQ(ob.timing.tracked, d.tracked ? 1 : 0);
+    EXPECT_EQ(ob.timing.track_steps, i == 0 ? 0 : 1) << "frame " << i;  // one track from frame 0
     ASSERT_TRUE(d.match);
     tracked += d.tracked;
   }
@@ -301,6 +302,7 @@ TEST_F(FoveaTest, TrackingServesTheFramesBetweenFullPasses) {
   const Observation none = perception.observe(gone, K, std::vector<std::string>{kTarget});
   EXPECT_EQ(countClass(none, kTarget), 0);
   EXPECT_TRUE(none.timing.full_pass);
+  EXPECT_EQ(none.timing.track_steps, 1);  // stepped, and lost
   // After reset() the first call is a full pass even though the landmark was just detected.
   hw::Frame back;
   back.image = sceneWith(photo, width, 300, 230, 12);

@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <fstream>
+#include <map>
 #include <memory>
 
 #include "run_harness.h"
@@ -84,6 +85,51 @@ TEST(ClosedLoop, ReachesTheGoalWithLandmarks) {
   for (const char* f : {"summary.json", "trajectory.png", "events.jsonl", "telemetry.csv"})
     EXPECT_TRUE(std::filesystem::exists(o.out_dir + "/" + f)) << f;
   EXPECT_GE(countEvents(o.out_dir, "landmark_passed"), 2);
+  // The loop's rates and latency budget (summary "timing"), as summary.json holds them: counts
+  // that nest, rates over both clocks, percentiles in order. No figure is held to a threshold.
+  std::ifstream in(o.out_dir + "/summary.json");
+  const Json t = Json::parse(in)["timing"];
+  ASSERT_TRUE(t.is_object());
+  const Json& r = t["rates_hz"];
+  auto n = [&](const char* k) { return r[k]["n"].get<int>(); };
+  EXPECT_GE(n("control_ticks"), n("camera_frames"));
+  EXPECT_GE(n("camera_frames"), n("perception_frames"));
+  EXPECT_GE(n("perception_frames"), n("full_passes"));
+  EXPECT_GE(n("perception_frames"), n("tracked_frames"));
+  EXPECT_GE(n("perception_frames"), n("servo_updates"));
+  EXPECT_EQ(n("perception_frames"), s["perception"]["frames_processed"].get<int>());
+  EXPECT_EQ(n("full_passes"), s["perception"]["full_passes"].get<int>());
+  // Two landmarks servoed on, with detect-then-track on by default.
+  for (const char* k : {"control_ticks", "camera_frames", "perception_frames", "full_passes",
+                        "tracked_frames", "servo_updates"}) {
+    EXPECT_GT(r[k]["clock"].get<double>(), 0) << k;
+    EXPECT_GT(r[k]["wall"].get<double>(), 0) << k;
+  }
+  const Json& l = t["latency_ms"];
+  const std::map<std::string, int> expect_n = {{"perception", n("perception_frames")},
+                                               {"objectness", n("full_passes")},
+                                               {"features", n("full_passes")},
+                                               {"match", n("full_passes")}};
+  for (const char* k :
+       {"grab_to_command", "perception", "objectness", "features", "match", "track"}) {
+    const Json& p = l[k];
+    ASSERT_GT(p["n"].get<int>(), 0) << k;
+    if (expect_n.count(k)) EXPECT_EQ(p["n"].get<int>(), expect_n.at(k)) << k;
+    EXPECT_GE(p["p50"].get<double>(), 0) << k;
+    EXPECT_LE(p["p50"].get<double>(), p["p95"].get<double>()) << k;
+    EXPECT_LE(p["p95"].get<double>(), p["p99"].get<double>()) << k;
+    EXPECT_LE(p["p99"].get<double>(), p["max"].get<double>()) << k;
+  }
+  // One sample per frame perception looked at whose tick reached a command: all of them unless
+  // the executive failed in a tick after perception. The tracker stepped on some of them.
+  EXPECT_LE(l["track"]["n"].get<int>(), n("perception_frames"));
+  EXPECT_LE(l["grab_to_command"]["n"].get<int>(), n("perception_frames"));
+  EXPECT_GE(l["grab_to_command"]["n"].get<int>(), n("perception_frames") - 1);
+  if (s["executive_success"].get<bool>()) {
+    EXPECT_EQ(l["grab_to_command"]["n"].get<int>(), n("perception_frames"));
+    // Each frame's latency holds its perception time.
+    EXPECT_GE(l["grab_to_command"]["max"].get<double>(), l["perception"]["max"].get<double>());
+  }
 }
 
 TEST(ClosedLoop, ReachesTheGoalWithOneLandmarkMissing) {

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "sketchnav/core/config.h"
+#include "sketchnav/core/percentiles.h"
 #include "sketchnav/hw/clock.h"
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/mapsketch/route.h"
@@ -264,6 +265,34 @@ struct LandmarkReport {
   int max_inliers = 0;
 };
 
+/// The control loop's rates and latency budget (summary.json "timing", doc/navigation.md
+/// "Loop rates and latency"). Counts cover the run, start() to its last tick; the rates divide
+/// them by the run's length on its clock (simulated time in simulation) and by the wall time of
+/// the same span.
+struct LoopTiming {
+  int ticks = 0;              // control ticks run
+  int frames = 0;             // camera frames delivered (a new stamp, an image)
+  int perception_frames = 0;  // frames given to perception
+  int full_passes = 0;        // of those, the ones perception's full pass ran on
+  int tracked_frames = 0;     // of those, the ones where the tracker supplied a detection
+  int servo_updates = 0;      // servo law evaluations on a new detection of the servoed landmark
+  double wall_s = 0;          // [s] wall time from start() to the end of the last tick
+  using Stats = PercentileAccumulator::Summary;
+  // [ms] from a frame's capture stamp to the base command of the tick that used its perception
+  // result (one sample per frame given to perception whose tick reached its command): the run
+  // clock from the stamp to the grab's return, plus the wall time from there to the command.
+  // In simulation the clock does not run while perception works, so the wall time is what a
+  // real robot would wait; on hardware both are the steady clock.
+  Stats grab_to_command_ms;
+  Stats perception_ms;                         // [ms] wall time per frame given to perception
+  Stats objectness_ms, features_ms, match_ms;  // [ms] wall time per full pass, by stage
+  Stats track_ms;  // [ms] the tracker's wall time, on frames where it stepped a track
+  /// {"time_s", "wall_s", "rates_hz": {"camera_frames": {"n", "clock", "wall"}, ...},
+  /// "latency_ms": {"grab_to_command": {"n", "p50", "p95", "p99", "max"}, ...}}; `time_s` is
+  /// the run's length on its clock [s]. A rate over a zero span is 0.
+  nlohmann::json toJson(double time_s) const;
+};
+
 struct ExecutiveSummary {
   RunStatus status = RunStatus::Idle;
   FailureCode failure = FailureCode::None;  // why it failed (None unless status is Failed)
@@ -283,6 +312,7 @@ struct ExecutiveSummary {
   int detours = 0;     // detours planned round obstacles (local_planner.h)
   int yields = 0;      // times the robot kept out of a walking person's lane (movers.h)
   LaserOdometryStats laser_odometry;
+  LoopTiming timing;  // loop rates and latency percentiles
   nlohmann::json toJson() const;
 };
 

@@ -58,6 +58,7 @@ struct PerceptionTiming {
   bool full_pass = false;   // the full pass (objectness, features, matching) ran on this frame
   double track_ms = 0;      // wall time of the tracker's steps (part of total_ms)
   int tracked = 0;          // detections that come from the tracker
+  int track_steps = 0;      // tracks the tracker stepped into this frame (found or lost)
 };
 
 /// A class to look for, with where the executive expects it (from the sketch). Without a
