@@ -20,6 +20,7 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/hash.h"
 #include "sketchnav/core/image_file.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/drivers/rawlog.h"
@@ -169,7 +170,9 @@ class RunObserver final : public nav::ExecutiveObserver {
     if (on_event) on_event(ev);
     if (const auto* d = ev.as<event::SectionDone>(); d && d->section == sections_ - 1)
       goal_odom = d->end_odom;
-    if (events_.is_open()) events_ << ev.toJson().dump() << std::endl;  // flushed per line
+    // One line, written whole and flushed (one write()): a run killed at any moment leaves
+    // events.jsonl readable to its last whole line.
+    if (events_.is_open()) events_ << ev.toJson().dump() + '\n' << std::flush;
     if (!progress_) return;
     char head[64];
     std::snprintf(head, sizeof head, "[t=%6.1fs] ", ev.t);
@@ -704,7 +707,9 @@ Json runNavigation(const RunOptions& o) {
   s["failure"] = failureCode(success, s.value("collided", false), es);
 
   if (!o.out_dir.empty()) {
-    std::ofstream(o.out_dir + "/summary.json") << s.dump(2) << "\n";
+    // Whole or not at all (temp file + rename): a run killed while writing it leaves no
+    // half summary.
+    writeFileAtomically(o.out_dir + "/summary.json", s.dump(2) + "\n", "run summary");
     if (simr) {
       drawTrajectory(o.out_dir + "/trajectory.png", simr->world(), sketch, route, r2w, traj);
     } else {
