@@ -26,6 +26,7 @@
 #include "sketchnav/drivers/rawlog.h"
 #include "sketchnav/drivers/recording.h"
 #include "sketchnav/drivers/register.h"
+#include "sketchnav/hw/gated_base.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/landmarks/photo_hash.h"
@@ -416,8 +417,10 @@ Json runNavigation(const RunOptions& o) {
 
   // --- devices ----------------------------------------------------------------------------
   std::shared_ptr<sim::Simulator> simr;
-  std::unique_ptr<hw::Camera> camera;
+  // `base` before `camera`: the camera may hold a pointer to the base's gate (below), so it
+  // is destroyed first.
   std::unique_ptr<hw::Base> base;
+  std::unique_ptr<hw::Camera> camera;
   std::unique_ptr<hw::RangeSensor> laser, sonar;
   std::string world_name = o.world;
   if (!hardware) {
@@ -472,6 +475,11 @@ Json runNavigation(const RunOptions& o) {
     if (laser) laser = drivers::recordRange(std::move(laser), rec, "LASER");
     if (sonar) sonar = drivers::recordRange(std::move(sonar), rec, "SONAR");
   }
+  // A camera that reports losing its device (aravis://, after its lost_timeout_s) stops the
+  // base in that call and blocks motion until frames flow again, whoever commands it; the
+  // executive then sees the base not ok and fails the run with the camera named. Outermost, so
+  // the recording and the run page's base get that stop too.
+  base = hw::stopBaseWhileCameraIsLost(std::move(base), *camera);
 
   // --- sketch -> route ----------------------------------------------------------------------
   std::string sketch_path = o.sketch;
