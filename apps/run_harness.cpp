@@ -20,11 +20,13 @@
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/hash.h"
 #include "sketchnav/core/image_file.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/drivers/rawlog.h"
 #include "sketchnav/drivers/recording.h"
 #include "sketchnav/drivers/register.h"
+#include "sketchnav/hw/gated_base.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/landmarks/photo_hash.h"
@@ -169,7 +171,9 @@ class RunObserver final : public nav::ExecutiveObserver {
     if (on_event) on_event(ev);
     if (const auto* d = ev.as<event::SectionDone>(); d && d->section == sections_ - 1)
       goal_odom = d->end_odom;
-    if (events_.is_open()) events_ << ev.toJson().dump() << std::endl;  // flushed per line
+    // One line, written whole and flushed (one write()): a run killed at any moment leaves
+    // events.jsonl readable to its last whole line.
+    if (events_.is_open()) events_ << ev.toJson().dump() + '\n' << std::flush;
     if (!progress_) return;
     char head[64];
     std::snprintf(head, sizeof head, "[t=%6.1fs] ", ev.t);
@@ -413,8 +417,10 @@ Json runNavigation(const RunOptions& o) {
 
   // --- devices ----------------------------------------------------------------------------
   std::shared_ptr<sim::Simulator> simr;
-  std::unique_ptr<hw::Camera> camera;
+  // `base` before `camera`: the camera may hold a pointer to the base's gate (below), so it
+  // is destroyed first.
   std::unique_ptr<hw::Base> base;
+  std::unique_ptr<hw::Camera> camera;
   std::unique_ptr<hw::RangeSensor> laser, sonar;
   std::string world_name = o.world;
   if (!hardware) {
@@ -469,6 +475,11 @@ Json runNavigation(const RunOptions& o) {
     if (laser) laser = drivers::recordRange(std::move(laser), rec, "LASER");
     if (sonar) sonar = drivers::recordRange(std::move(sonar), rec, "SONAR");
   }
+  // A camera that reports losing its device (aravis://, after its lost_timeout_s) stops the
+  // base in that call and blocks motion until frames flow again, whoever commands it; the
+  // executive then sees the base not ok and fails the run with the camera named. Outermost, so
+  // the recording and the run page's base get that stop too.
+  base = hw::stopBaseWhileCameraIsLost(std::move(base), *camera);
 
   // --- sketch -> route ----------------------------------------------------------------------
   std::string sketch_path = o.sketch;
@@ -706,7 +717,9 @@ Json runNavigation(const RunOptions& o) {
   s["failure"] = failureCode(success, s.value("collided", false), es);
 
   if (!o.out_dir.empty()) {
-    std::ofstream(o.out_dir + "/summary.json") << s.dump(2) << "\n";
+    // Whole or not at all (temp file + rename): a run killed while writing it leaves no
+    // half summary.
+    writeFileAtomically(o.out_dir + "/summary.json", s.dump(2) + "\n", "run summary");
     if (simr) {
       drawTrajectory(o.out_dir + "/trajectory.png", simr->world(), sketch, route, r2w, traj);
     } else {

@@ -18,6 +18,7 @@
 #include <sstream>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/hw/forwarding.h"
@@ -550,7 +551,12 @@ void RunController::runThread(RunRequest request) {
     if (!h.out_dir.empty() && !fs::exists(fs::path(h.out_dir) / "summary.json")) {
       summary = {{"success", false}, {"error", true}, {"reason", reason},
                  {"request", request.toJson()}, {"out_dir", h.out_dir}};
-      std::ofstream(fs::path(h.out_dir) / "summary.json") << summary.dump(2) << "\n";
+      try {
+        writeFileAtomically((fs::path(h.out_dir) / "summary.json").string(),
+                            summary.dump(2) + "\n", "run summary");
+      } catch (const std::exception& w) {
+        log::error("ui", "cannot write the run's summary", {{"error", w.what()}});
+      }
     }
   }
   std::lock_guard<std::mutex> l(live->m);

@@ -1,6 +1,7 @@
 #include "sketchnav/core/input_file.h"
 
 #include <sys/stat.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -86,6 +87,30 @@ void requireOutputFile(const std::string& path, const std::string& what) {
   if (!std::filesystem::is_directory(parent, ec))
     throw InputError(quoted(what, path) + ": folder '" + clipForMessage(parent.string(), 200) +
                      "' does not exist");
+}
+
+void writeFileAtomically(const std::string& path, const std::string& data,
+                         const std::string& what) {
+  // The rename below would replace a device node or FIFO: refused first.
+  requireOutputFile(path, what);
+  const std::string tmp = path + ".tmp." + std::to_string(::getpid());
+  std::error_code ec;
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    if (!out) throw RuntimeError(quoted(what, path) + ": cannot write " + tmp);
+    out.write(data.data(), static_cast<std::streamsize>(data.size()));
+    out.close();
+    if (!out) {
+      std::filesystem::remove(tmp, ec);
+      throw RuntimeError(quoted(what, path) + ": writing failed (disk full?)");
+    }
+  }
+  std::filesystem::rename(tmp, path, ec);
+  if (ec) {
+    const std::string why = ec.message();
+    std::filesystem::remove(tmp, ec);
+    throw RuntimeError(quoted(what, path) + ": cannot move it into place: " + why);
+  }
 }
 
 }  // namespace sketchnav

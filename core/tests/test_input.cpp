@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 #include <sys/stat.h>
 
+#include <filesystem>
 #include <fstream>
 
 #include "sketchnav/core/config.h"
@@ -104,6 +105,25 @@ TEST(InputFile, OutputsOnlyToRegularFilesInExistingFolders) {
   EXPECT_NE(m.find("does not exist"), std::string::npos) << m;
   EXPECT_THROW(requireOutputFile(dir, "-o"), InputError);
   EXPECT_THROW(log::setFile("/dev/full"), InputError);
+}
+
+TEST(InputFile, AtomicWriteReplacesWholeAndLeavesNoTemporary) {
+  const std::string dir = test::tempDir("atomic_write");
+  const std::string path = dir + "/summary.json";
+  write(path, "old, longer than the new content");
+  writeFileAtomically(path, "{}\n", "run summary");
+  std::ifstream in(path);
+  EXPECT_EQ(std::string(std::istreambuf_iterator<char>(in), {}), "{}\n");
+  int files = 0;
+  for (const auto& e : std::filesystem::directory_iterator(dir)) files += e.is_regular_file();
+  EXPECT_EQ(files, 1) << "a temporary file was left beside " << path;
+  // Special files are refused, never renamed over.
+  const std::string m = messageOf([] { writeFileAtomically("/dev/full", "x", "run summary"); });
+  EXPECT_NE(m.find("run summary '/dev/full'"), std::string::npos) << m;
+  struct stat st {};
+  ASSERT_EQ(::stat("/dev/full", &st), 0);
+  EXPECT_TRUE(S_ISCHR(st.st_mode));
+  EXPECT_THROW(writeFileAtomically("/nonexistent-dir/sub/s.json", "x", "run summary"), InputError);
 }
 
 TEST(InputFile, ClipKeepsShortValuesAndCutsLongOnes) {

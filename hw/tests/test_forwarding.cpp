@@ -165,3 +165,52 @@ TEST(GatedBase, ClosingStopsAtOnceAndCommandsBecomeStopsUntilReopened) {
   log->healthy = false;
   EXPECT_FALSE(gate.ok());
 }
+
+namespace {
+// A camera that reports its link: the decorators pass the callback through to it.
+struct LinkCamera final : ForwardingCamera {
+  using ForwardingCamera::ForwardingCamera;
+};
+struct ReportingCamera final : Camera {
+  GrabStatus grab(Frame&, double) override { return GrabStatus::Timeout; }
+  Intrinsics intrinsics() const override { return {}; }
+  DeviceStats stats() const override { return {}; }
+  std::string uri() const override { return "log://reporting"; }
+  bool setLinkCallback(std::function<void(bool)> cb) override {
+    link = std::move(cb);
+    return true;
+  }
+  std::function<void(bool)> link;
+};
+}  // namespace
+
+TEST(GatedBase, ACameraReportingItsDeviceLostThroughDecoratorsClosesTheGate) {
+  auto inner_cam = std::make_unique<ReportingCamera>();
+  ReportingCamera* device = inner_cam.get();
+  LinkCamera cam(std::move(inner_cam));  // e.g. the recording around the real camera
+  auto inner = std::make_unique<LogBase>();
+  LogBase* log = inner.get();
+  auto base = stopBaseWhileCameraIsLost(std::move(inner), cam);
+  ASSERT_TRUE(device->link) << "the decorator did not pass the callback on";
+  base->command(0.2, 0.0);
+  EXPECT_EQ(log->commands, 1);
+  device->link(false);
+  EXPECT_EQ(log->stops, 1) << "not stopped in the call that reported the camera lost";
+  EXPECT_FALSE(base->ok());
+  // The reason the executive reports with its fault names the camera.
+  EXPECT_NE(base->stats().last_error.find("camera lost (log://reporting)"), std::string::npos)
+      << base->stats().last_error;
+  base->command(0.2, 0.0);
+  EXPECT_EQ(log->commands, 1);
+  device->link(true);
+  EXPECT_TRUE(base->ok());
+  EXPECT_TRUE(base->stats().last_error.empty());
+  base->command(0.2, 0.0);
+  EXPECT_EQ(log->commands, 2);
+
+  // A camera that cannot report its link never closes the gate.
+  PlainCamera plain(std::make_unique<LogCamera>());
+  EXPECT_FALSE(plain.setLinkCallback([](bool) {}));
+  auto open = stopBaseWhileCameraIsLost(std::make_unique<LogBase>(), plain);
+  EXPECT_TRUE(open->ok());
+}

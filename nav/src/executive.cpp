@@ -458,8 +458,15 @@ struct Executive::Impl {
     const auto st = safety.check(now, dev.base->ok());
     if (!st.ok()) {
       dev.base->stop();
-      event(event::Fault{toString(st.fault), st.reason});
-      fail(FailureCode::SafetyStop, "safety stop: " + st.reason);
+      std::string reason = st.reason;
+      // The base says why it is not ok (a link timeout, or a gate closed because the camera
+      // was lost): "base link lost" alone would send the user to the wrong device.
+      if (st.fault == Fault::BaseLinkLost) {
+        const std::string why = dev.base->stats().last_error;
+        if (!why.empty()) reason += ": " + why;
+      }
+      event(event::Fault{toString(st.fault), reason});
+      fail(FailureCode::SafetyStop, "safety stop: " + reason);
       return;
     }
     if (now - t0 > s.exec.max_time_s) {

@@ -15,6 +15,7 @@
 #include <cmath>
 #include <condition_variable>
 #include <cstdio>
+#include <initializer_list>
 #include <limits>
 #include <map>
 
@@ -32,6 +33,26 @@ using detail::wallNow;
 
 double stampOf(const ::ros::Time& t) {
   return t.isZero() ? ::ros::Time::now().toSec() : t.toSec();
+}
+
+// Why a pose from a message cannot be used, the one rule for nav_msgs/Odometry and a tf
+// odom -> base transform: a NaN or Inf in its position, its orientation quaternion or the
+// values that came with it (`extra`, e.g. the twist), or a zero quaternion (no orientation).
+enum class PoseFault { None, NotFinite, ZeroQuaternion };
+
+// PoseFault::None and `yaw` [rad] from the normalised quaternion when the pose is usable.
+template <class Point, class Quaternion>
+PoseFault poseFault(const Point& p, const Quaternion& q, std::initializer_list<double> extra,
+                    double& yaw) {
+  bool finite = std::isfinite(p.x) && std::isfinite(p.y) && std::isfinite(q.x) &&
+                std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w);
+  for (double v : extra) finite = finite && std::isfinite(v);
+  if (!finite) return PoseFault::NotFinite;
+  const double qn = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
+  if (qn < 1e-6) return PoseFault::ZeroQuaternion;
+  double roll, pitch;
+  tf2::Matrix3x3(tf2::Quaternion(q.x / qn, q.y / qn, q.z / qn, q.w / qn)).getRPY(roll, pitch, yaw);
+  return PoseFault::None;
 }
 
 // Fills in what the watchdog needs once the subscription exists (before addInput()).
@@ -312,26 +333,20 @@ class RosBase final : public hw::Base {
   void onOdom(const nav_msgs::OdometryConstPtr& m) {
     in_->wall_last = wallNow();
     const auto& p = m->pose.pose.position;
-    const auto& q = m->pose.pose.orientation;
-    const double vals[] = {
-        p.x, p.y, q.x, q.y, q.z, q.w, m->twist.twist.linear.x, m->twist.twist.angular.z};
-    bool finite = true;
-    for (double v : vals) finite = finite && std::isfinite(v);
-    const double qn = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-    if (!finite || qn < 1e-6) {
+    double yaw = 0;
+    const PoseFault fault = poseFault(p, m->pose.pose.orientation,
+                                      {m->twist.twist.linear.x, m->twist.twist.angular.z}, yaw);
+    if (fault != PoseFault::None) {
+      const bool zero = fault == PoseFault::ZeroQuaternion;
       {
         std::lock_guard<std::mutex> l(m_);
         ++st_.dropped;
-        st_.last_error = finite ? "zero quaternion" : "NaN or Inf in pose or twist";
+        st_.last_error = zero ? "zero quaternion" : "NaN or Inf in pose or twist";
       }
-      detail::garbage(
-          "odometry on " + sub_.getTopic() + ": " +
-          (finite ? "orientation is a zero quaternion" : "NaN or Inf in pose or twist"));
+      detail::garbage("odometry on " + sub_.getTopic() + ": " +
+                      (zero ? "orientation is a zero quaternion" : "NaN or Inf in pose or twist"));
       return;
     }
-    double roll, pitch, yaw;
-    tf2::Matrix3x3(tf2::Quaternion(q.x / qn, q.y / qn, q.z / qn, q.w / qn))
-        .getRPY(roll, pitch, yaw);
     std::lock_guard<std::mutex> l(m_);
     odom_.pose = {p.x, p.y, yaw};
     odom_.v = m->twist.twist.linear.x;
@@ -369,24 +384,19 @@ class RosBase final : public hw::Base {
     }
     in_->wall_last = wallNow();
     const auto& p = direct->transform.translation;
-    const auto& q = direct->transform.rotation;
-    const double vals[] = {p.x, p.y, q.x, q.y, q.z, q.w};
-    bool finite = true;
-    for (double v : vals) finite = finite && std::isfinite(v);
-    const double qn = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-    if (!finite || qn < 1e-6) {
+    double yaw = 0;
+    const PoseFault fault = poseFault(p, direct->transform.rotation, {}, yaw);
+    if (fault != PoseFault::None) {
+      const bool zero = fault == PoseFault::ZeroQuaternion;
       {
         std::lock_guard<std::mutex> l(m_);
         ++st_.dropped;
-        st_.last_error = finite ? "zero quaternion" : "NaN or Inf in the transform";
+        st_.last_error = zero ? "zero quaternion" : "NaN or Inf in the transform";
       }
       detail::garbage(in_->what + ": " +
-                      (finite ? "rotation is a zero quaternion" : "NaN or Inf in the transform"));
+                      (zero ? "rotation is a zero quaternion" : "NaN or Inf in the transform"));
       return;
     }
-    double roll, pitch, yaw;
-    tf2::Matrix3x3(tf2::Quaternion(q.x / qn, q.y / qn, q.z / qn, q.w / qn))
-        .getRPY(roll, pitch, yaw);
     std::lock_guard<std::mutex> l(m_);
     // Velocities by differencing (tf carries none), over at least 20 ms.
     if (have_ && stamp - vel_from_.stamp >= 0.02) {

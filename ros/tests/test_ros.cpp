@@ -21,6 +21,7 @@
 #include <sensor_msgs/LaserScan.h>
 #include <signal.h>
 #include <std_msgs/String.h>
+#include <tf2_msgs/TFMessage.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
 #include <unistd.h>
@@ -425,6 +426,7 @@ struct Garbage {
   const char* name;
   const char* expect;             // in the node's stderr
   const char* also_ok = nullptr;  // or this (two supervisors may see it first)
+  bool tf_odometry = false;       // odometry as a tf odom -> base_link (ros.odom_source=tf)
 };
 void PrintTo(const Garbage& g, std::ostream* os) {
   *os << g.name;
@@ -439,6 +441,7 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
   auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
   auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
   auto scan_pub = nh_->advertise<sensor_msgs::LaserScan>("scan", 5);
+  auto tf_pub = nh_->advertise<tf2_msgs::TFMessage>("/tf", 5);
   std::atomic<bool> stop{false}, bad{false};
   std::thread robot([&] {
     while (!stop) {
@@ -468,12 +471,28 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
       ci.height = 48;
       ci.K = {55, 0, 31.5, 0, 55, 23.5, 0, 0, 1};
       info_pub.publish(ci);
-      nav_msgs::Odometry od;
-      od.header.stamp = now;
-      od.pose.pose.orientation.w = 1;
-      if (b && std::string(g.name) == "nan_odometry")
-        od.pose.pose.position.x = std::numeric_limits<double>::quiet_NaN();
-      odom_pub.publish(od);
+      const double not_a_number = std::numeric_limits<double>::quiet_NaN();
+      if (g.tf_odometry) {
+        geometry_msgs::TransformStamped t;
+        t.header.stamp = now;
+        t.header.frame_id = "odom";
+        t.child_frame_id = "base_link";
+        t.transform.rotation.w = 1;
+        if (b && std::string(g.name) == "nan_tf_odometry") t.transform.translation.y = not_a_number;
+        if (b && std::string(g.name) == "zero_quaternion_tf") t.transform.rotation.w = 0;
+        tf2_msgs::TFMessage tf;
+        tf.transforms.push_back(t);
+        tf_pub.publish(tf);
+      } else {
+        nav_msgs::Odometry od;
+        od.header.stamp = now;
+        od.pose.pose.orientation.w = 1;
+        if (b && std::string(g.name) == "nan_odometry") od.pose.pose.position.x = not_a_number;
+        if (b && std::string(g.name) == "inf_twist")
+          od.twist.twist.angular.z = std::numeric_limits<double>::infinity();
+        if (b && std::string(g.name) == "zero_quaternion_odometry") od.pose.pose.orientation.w = 0;
+        odom_pub.publish(od);
+      }
       sensor_msgs::LaserScan sc;
       sc.header.stamp = now;
       sc.header.frame_id = "base_link";
@@ -488,8 +507,10 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });
-  startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set",
-                                  "ros.camera_mount_from_tf=false", "--max-time", "60"});
+  std::vector<std::string> args = {
+      "--set", "ros.sonar_topic=", "--set", "ros.camera_mount_from_tf=false", "--max-time", "60"};
+  if (g.tf_odometry) args.insert(args.end(), {"--set", "ros.odom_source=tf"});
+  startNav(shortLabSketch(dir_), args);
   // Running: the route has started (its first commands).
   const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
   bool ran = nav_->running();
@@ -523,6 +544,16 @@ INSTANTIATE_TEST_SUITE_P(
     ::testing::Values(Garbage{"empty_image", "camera on /image_raw: empty image"},
                       Garbage{"wrong_encoding", "encoding '32FC1'"},
                       Garbage{"nan_odometry", "odometry on /odom: NaN"},
+                      Garbage{"inf_twist", "odometry on /odom: NaN or Inf in pose or twist"},
+                      Garbage{"zero_quaternion_odometry",
+                              "odometry on /odom: orientation is a zero quaternion"},
+                      // The one pose rule (poseFault) on the tf odometry source too.
+                      Garbage{"nan_tf_odometry",
+                              "odometry (tf odom -> base_link): NaN or Inf in the transform",
+                              nullptr, true},
+                      Garbage{"zero_quaternion_tf",
+                              "odometry (tf odom -> base_link): rotation is a zero quaternion",
+                              nullptr, true},
                       Garbage{"scan_wrong_length", "the scan has 50 ranges"},
                       Garbage{"frozen_camera", "camera on /image_raw: no message for",
                               // the executive's own check on ROS time, same 0.5 s limit

@@ -26,11 +26,13 @@ add_test(NAME cli_recognise_pictures
           -DWORK=${CMAKE_CURRENT_BINARY_DIR}/cli-recognise-pictures
           -P ${CMAKE_CURRENT_SOURCE_DIR}/cli/recognise_outputs.cmake)
 set_tests_properties(cli_recognise_pictures PROPERTIES TIMEOUT 600)
-# kill -9 during `sketchnav run` leaves telemetry.csv whole rows (issue 28).
+# kill -9 during `sketchnav run` leaves every output readable to its last whole record
+# (telemetry.csv, events.jsonl, the log file, the rawlog, summary.json, trajectory.png; issue 28).
 if(SKETCHNAV_BUILD_TESTS)
   add_executable(test_run_kill ${CMAKE_CURRENT_LIST_DIR}/test_run_kill.cpp)
   add_dependencies(test_run_kill sketchnav)  # the test runs the command itself
-  target_link_libraries(test_run_kill PRIVATE sketchnav_test_support GTest::gtest_main)
+  target_link_libraries(test_run_kill PRIVATE sketchnav::drivers opencv_imgcodecs
+                        sketchnav_test_support GTest::gtest_main)
   target_include_directories(test_run_kill PRIVATE ${PROJECT_SOURCE_DIR}/tests/hardware)
   target_compile_definitions(test_run_kill PRIVATE SKETCHNAV_EXE="$<TARGET_FILE:sketchnav>")
   gtest_discover_tests(test_run_kill DISCOVERY_TIMEOUT 60 PROPERTIES TIMEOUT 600 LABELS cli)

@@ -6,8 +6,11 @@
 
 #include <algorithm>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <memory>
+#include <string>
+#include <vector>
 
 #include "run_harness.h"
 #include "sketchnav/hw/devices.h"
@@ -68,6 +71,58 @@ class DroppingCamera final : public hw::ForwardingCamera {
   double drop_at_;
   bool dropped_ = false;
   double* last_stamp_;  // outlives the camera (the run destroys its devices)
+};
+
+// Delivers frames until `drop_at` seconds of simulated time, then none; `lost_after_s` later
+// (by the stamps of the frames it keeps taking from the simulator and throwing away) it
+// reports its device lost through the link callback, as aravis:// does after lost_timeout_s.
+class LinkLosingCamera final : public hw::ForwardingCamera {
+ public:
+  LinkLosingCamera(std::unique_ptr<hw::Camera> inner, double drop_at, double lost_after_s,
+                   std::vector<std::string>* trace, double* lost_t)
+      : ForwardingCamera(std::move(inner)),
+        drop_at_(drop_at),
+        lost_after_s_(lost_after_s),
+        trace_(trace),
+        lost_t_(lost_t) {}
+  bool setLinkCallback(std::function<void(bool)> cb) override {
+    link_ = std::move(cb);
+    return true;
+  }
+  hw::GrabStatus grab(hw::Frame& f, double timeout_s) override {
+    const auto st = inner().grab(f, timeout_s);
+    if (st != hw::GrabStatus::Ok || f.stamp < drop_at_) return st;
+    if (*lost_t_ < 0 && f.stamp >= drop_at_ + lost_after_s_) {
+      *lost_t_ = f.stamp;
+      trace_->push_back("lost");
+      if (link_) link_(false);
+    }
+    return hw::GrabStatus::Timeout;
+  }
+
+ private:
+  double drop_at_, lost_after_s_;
+  std::vector<std::string>* trace_;  // both outlive the camera
+  double* lost_t_;
+  std::function<void(bool)> link_;
+};
+
+// Writes what the base is told into `trace`: "move" (a non-zero command), "zero", "stop".
+class TracedBase final : public hw::ForwardingBase {
+ public:
+  TracedBase(std::unique_ptr<hw::Base> inner, std::vector<std::string>* trace)
+      : ForwardingBase(std::move(inner)), trace_(trace) {}
+  void command(double v, double w) override {
+    trace_->push_back(v != 0 || w != 0 ? "move" : "zero");
+    inner().command(v, w);
+  }
+  void stop() noexcept override {
+    trace_->push_back("stop");
+    inner().stop();
+  }
+
+ private:
+  std::vector<std::string>* trace_;
 };
 
 }  // namespace
@@ -179,6 +234,36 @@ TEST(ClosedLoop, StopsOnADroppedCamera) {
   // The stop command follows the last frame within the stale timeout + 200 ms.
   EXPECT_LE(s["time_s"].get<double>(), last_stamp + 0.15 + 0.2);
   EXPECT_GE(s["time_s"].get<double>(), 6.0);
+  EXPECT_EQ(countEvents(o.out_dir, "fault"), 1);
+}
+
+// A camera that reports its device lost (aravis:// after lost_timeout_s) stops the base in that
+// very call, not at the executive's next look: the stale-frame check is switched off here
+// (nav.safety.require_camera=false), so only the camera-lost gate of the run can stop it.
+TEST(ClosedLoop, ACameraReportingItsDeviceLostStopsTheBaseAtOnce) {
+  auto o = options("hall", 1, "-camera-lost");
+  o.config.set("nav.safety.require_camera", false);
+  std::vector<std::string> trace;  // the camera's "lost" among what the base was told
+  double lost_t = -1;
+  o.wrap_camera = [&](std::unique_ptr<hw::Camera> inner) {
+    return std::unique_ptr<hw::Camera>(
+        std::make_unique<LinkLosingCamera>(std::move(inner), 6.0, 0.5, &trace, &lost_t));
+  };
+  o.wrap_base = [&](std::unique_ptr<hw::Base> inner) {
+    return std::unique_ptr<hw::Base>(std::make_unique<TracedBase>(std::move(inner), &trace));
+  };
+  const Json s = app::runNavigation(o);
+  ASSERT_GT(lost_t, 6.4) << "the camera never reported itself lost: " << s["reason"];
+  const auto lost = std::find(trace.begin(), trace.end(), "lost");
+  ASSERT_NE(lost, trace.end());
+  ASSERT_NE(lost + 1, trace.end()) << "the base was told nothing after the camera was lost";
+  EXPECT_EQ(*(lost + 1), "stop") << "the base was not stopped as the camera reported it lost";
+  EXPECT_EQ(std::count(lost, trace.end(), "move"), 0) << "the base moved with the camera lost";
+  EXPECT_GT(std::count(trace.begin(), lost, "move"), 10) << "the robot was not driving before";
+  EXPECT_FALSE(s["success"].get<bool>());
+  EXPECT_NE(s["reason"].get<std::string>().find("camera lost"), std::string::npos) << s["reason"];
+  // The run ends at the executive's next tick (0.05 s), well within the 200 ms.
+  EXPECT_LE(s["time_s"].get<double>(), lost_t + 0.2);
   EXPECT_EQ(countEvents(o.out_dir, "fault"), 1);
 }
 

@@ -18,7 +18,6 @@
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
-#include "sketchnav/hw/gated_base.h"
 
 namespace sketchnav::drivers {
 
@@ -486,9 +485,10 @@ DeviceStats AravisCamera::stats() const {
   return impl_->stats;
 }
 
-void AravisCamera::setLinkCallback(std::function<void(bool)> cb) {
+bool AravisCamera::setLinkCallback(std::function<void(bool)> cb) {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   impl_->callback = std::move(cb);
+  return true;
 }
 
 bool AravisCamera::connected() const {
@@ -509,15 +509,6 @@ double AravisCamera::meanLatencyMs() const {
 std::string AravisCamera::pixelFormat() const {
   std::lock_guard<std::mutex> lock(impl_->mutex);
   return impl_->pixel_format;
-}
-
-std::unique_ptr<Base> stopBaseWhileCameraIsLost(std::unique_ptr<Base> base, Camera& camera) {
-  auto* live = dynamic_cast<AravisCamera*>(&camera);
-  if (!live) return base;
-  auto gated = std::make_unique<hw::GatedBase>(std::move(base));
-  hw::GatedBase* gate = gated.get();
-  live->setLinkCallback([gate](bool up) { gate->setOpen(up); });
-  return gated;
 }
 
 }  // namespace sketchnav::drivers

@@ -5,9 +5,11 @@
 
 #include <algorithm>
 #include <cmath>
+#include <filesystem>
 
 #include "geometry.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 
 namespace sketchnav::sim {
 namespace {
@@ -233,13 +235,17 @@ void MapCanvas::drawLegend(const std::vector<std::pair<std::string, cv::Scalar>>
 }
 
 void MapCanvas::save(const std::string& path) const {
+  // Encoded in memory and written whole (temp file + rename): a run killed while saving its
+  // trajectory.png leaves no half image behind.
   bool ok = false;
+  std::vector<uchar> bytes;
   try {
-    ok = cv::imwrite(path, image_);
+    ok = cv::imencode(std::filesystem::path(path).extension().string(), image_, bytes);
   } catch (const cv::Exception& e) {
     throw RuntimeError("cannot write map image '" + path + "': " + e.what());
   }
   if (!ok) throw RuntimeError("cannot write map image '" + path + "'");
+  writeFileAtomically(path, std::string(bytes.begin(), bytes.end()), "map image");
 }
 
 }  // namespace sketchnav::sim

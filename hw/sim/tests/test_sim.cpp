@@ -868,7 +868,8 @@ TEST(MapCanvas, DrawsTheWorldAndTrajectories) {
   const std::string dir = test::tempDir("map");
   m.save(dir + "/map.png");
   EXPECT_FALSE(cv::imread(dir + "/map.png").empty());
-  EXPECT_THROW(m.save("/nonexistent-dir/map.png"), RuntimeError);
+  // A missing folder is bad input (outputs go only into folders that exist).
+  EXPECT_THROW(m.save("/nonexistent-dir/map.png"), InputError);
 }
 
 TEST(Range, ClosedDoorBlocksOpenDoorDoesNot) {

@@ -26,6 +26,12 @@ std::string readInputFile(const std::string& path, const std::string& what,
 /// regular file (e.g. /dev/full, a FIFO, a directory), or its parent folder does not exist.
 void requireOutputFile(const std::string& path, const std::string& what);
 
+/// Writes `data` to `path` whole or not at all: requireOutputFile(), then a temporary file
+/// beside it (`<path>.tmp.<pid>`) renamed over `path`, so a reader, or a process killed
+/// mid-write (kill -9), never leaves a half-written file under `path`. RuntimeError naming the
+/// file when it cannot be written.
+void writeFileAtomically(const std::string& path, const std::string& data, const std::string& what);
+
 /// `s` cut to its first `max_chars` bytes plus "…" when longer, for quoting user values in
 /// one-line error messages.
 std::string clipForMessage(const std::string& s, std::size_t max_chars = 80);

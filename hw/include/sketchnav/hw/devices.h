@@ -13,6 +13,7 @@
 // command(), odometry(), ok() and stats() under one mutex. (On the simulator it only flags
 // the stop, and the run thread's next command() becomes stop().) Implementations that are
 // safe for concurrent calls say so: DaniLink/DaniBase, GatedBase, sim::Simulator's devices.
+#include <functional>
 #include <string>
 
 #include "sketchnav/hw/types.h"
@@ -39,6 +40,10 @@ class Camera {
   virtual Intrinsics intrinsics() const = 0;
   virtual DeviceStats stats() const = 0;
   virtual std::string uri() const = 0;
+  /// Asks to be told when the device is lost (`up` false) and when frames flow again (true),
+  /// on the thread calling grab(). False when this camera cannot tell (the default: the
+  /// executive's stale-frame check is then what stops the robot); decorators forward it.
+  virtual bool setLinkCallback(std::function<void(bool up)> /*cb*/) { return false; }
 };
 
 class Base {

@@ -46,6 +46,9 @@ class ForwardingCamera : public Camera {
   Intrinsics intrinsics() const override { return inner_->intrinsics(); }
   DeviceStats stats() const override { return inner_->stats(); }
   std::string uri() const override { return inner_->uri(); }
+  bool setLinkCallback(std::function<void(bool up)> cb) override {
+    return inner_->setLinkCallback(std::move(cb));
+  }
 
   Camera& inner() const { return *inner_; }
 

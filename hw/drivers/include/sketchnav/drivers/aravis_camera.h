@@ -68,9 +68,10 @@ class AravisCamera final : public Camera {
   DeviceStats stats() const override;
   std::string uri() const override { return uri_; }
 
-  /// Called with false when the camera is lost and true when frames flow again (from the
-  /// thread calling grab()). The run command wires this to "stop the base / allow motion".
-  void setLinkCallback(std::function<void(bool up)> cb);
+  /// Called with false when the camera is lost (no frame for `lost_timeout_s`, or the device
+  /// gone) and true when frames flow again, from the thread calling grab(). `sketchnav run`
+  /// wires it to "stop the base / allow motion" (hw::stopBaseWhileCameraIsLost). True.
+  bool setLinkCallback(std::function<void(bool up)> cb) override;
   bool connected() const;
   std::uint64_t reconnects() const;
   std::string pixelFormat() const;  // what the camera streams
@@ -83,11 +84,5 @@ class AravisCamera final : public Camera {
   std::unique_ptr<Impl> impl_;
   std::string uri_;
 };
-
-/// When `camera` can report losing its device (an AravisCamera), wraps `base` in a
-/// hw::GatedBase so that it is stopped at once when the camera is lost and stays stopped until
-/// frames flow again; other cameras leave `base` as it is. The camera keeps a pointer to the
-/// returned base: destroy the camera before it.
-std::unique_ptr<Base> stopBaseWhileCameraIsLost(std::unique_ptr<Base> base, Camera& camera);
 
 }  // namespace sketchnav::drivers
