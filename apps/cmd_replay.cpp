@@ -421,6 +421,10 @@ int runEval(const Args& args, GlobalOptions& g) {
               << result["false_reports"] << " / " << result["absent_frames"]
               << " target-absent frames, bearing error median " << result["bearing_error_px_median"]
               << " px, " << result["ms_per_frame_median"] << " ms per frame (median)\n";
+    std::cout << "frame budget:";
+    for (const auto& b : result["frame_budget"])
+      std::printf(" %.0f ms met on %s", b["budget_ms"].get<double>(), pct(b["met_rate"]).c_str());
+    std::cout << " of the frames\n";
     for (const char* key : {"by_yaw_deg", "by_width_px"})
       for (const auto& b : result[key])
         std::cout << "  " << key << " " << b["lo"] << "-" << b["hi"] << ": found "

@@ -61,6 +61,7 @@ import json, sys
 r = json.load(open(sys.argv[1])); s = json.loads(sys.argv[3])
 keys = ["sequences", "frames", "scored_frames", "agreement", "found_rate", "absent_frames",
         "false_reports", "false_report_rate", "bearing_error_px_median", "ms_per_frame_median",
+        "ms_per_frame_p95", "frame_budget",
         "by_motion"]
 s[sys.argv[2]] = {k: r[k] for k in keys}
 s[sys.argv[2]]["found_rate_by_yaw"] = {f'{b["lo"]:g}-{b["hi"]:g}': b["found_rate"] for b in r["by_yaw_deg"]}

@@ -184,6 +184,18 @@ TEST(BenchmarkSummary, CountsAgreementFoundRateBinsAndFalseReports) {
   EXPECT_EQ(s["bearing_frames"], 3);
   EXPECT_DOUBLE_EQ(s["bearing_error_px_median"].get<double>(), 4.0);  // of 4, 200, 2
   EXPECT_DOUBLE_EQ(s["ms_per_frame_median"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(s["ms_per_frame_p95"].get<double>(), 300.0);
+  // Five frames took 100 ms, one 300 ms: none fits 33 or 50 ms, five fit 100 ms.
+  const auto& fb = s["frame_budget"];
+  ASSERT_EQ(fb.size(), 3u);
+  EXPECT_EQ(fb[0]["met"], 0);
+  EXPECT_EQ(fb[0]["missed"], 6);
+  EXPECT_DOUBLE_EQ(fb[1]["budget_ms"].get<double>(), 50.0);
+  EXPECT_EQ(fb[1]["met"], 0);
+  EXPECT_DOUBLE_EQ(fb[2]["budget_ms"].get<double>(), 100.0);
+  EXPECT_EQ(fb[2]["met"], 5);
+  EXPECT_EQ(fb[2]["missed"], 1);
+  EXPECT_NEAR(fb[2]["met_rate"].get<double>(), 5.0 / 6, 1e-12);
   const auto& yb = s["by_yaw_deg"];
   ASSERT_EQ(yb.size(), 4u);
   EXPECT_EQ(yb[0]["frames"], 1);
