@@ -17,6 +17,7 @@
 #include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
+#include "sketchnav/core/percentiles.h"
 
 namespace sketchnav::app::bench {
 namespace fs = std::filesystem;
@@ -481,10 +482,10 @@ int binOf(const std::vector<double>& edges, double v) {
       return static_cast<int>(b);
   return -1;
 }
+// The project's one quantile rule (core/percentiles.h: nearest rank), as in summary.json.
 double quantile(std::vector<double> v, double q) {
-  if (v.empty()) return NAN;
   std::sort(v.begin(), v.end());
-  return v[std::min(v.size() - 1, static_cast<size_t>(q * v.size()))];
+  return nearestRankQuantile(v, q);
 }
 Json num(double v) {
   return std::isfinite(v) ? Json(v) : Json(nullptr);

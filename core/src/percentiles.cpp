@@ -12,8 +12,17 @@ constexpr double kNaN = std::numeric_limits<double>::quiet_NaN();
 }
 
 void PercentileAccumulator::add(double x) {
-  if (std::isfinite(x)) samples_.push_back(x);
+  if (!std::isfinite(x)) return;
+  samples_.push_back(x);
+  sum_ += x;
+  max_ = std::max(max_, x);
 }
+
+double PercentileAccumulator::mean() const {
+  return samples_.empty() ? kNaN : sum_ / static_cast<double>(samples_.size());
+}
+
+double PercentileAccumulator::max() const { return samples_.empty() ? kNaN : max_; }
 
 double nearestRankQuantile(const std::vector<double>& sorted, double q) {
   if (!(q >= 0 && q <= 1)) throw std::invalid_argument("quantile: q must be in [0, 1]");

@@ -75,6 +75,23 @@ TEST(Percentiles, NonFiniteValuesAreLeftOut) {
   EXPECT_EQ(a.count(), 3u);
   EXPECT_EQ(a.summary().p50, 2);
   EXPECT_EQ(a.summary().max, 3);
+  EXPECT_EQ(a.mean(), 2);
+  EXPECT_EQ(a.max(), 3);
+}
+
+TEST(Percentiles, MeanAndMaxAreRunningAndNaNWhenEmpty) {
+  PercentileAccumulator a;
+  EXPECT_TRUE(std::isnan(a.mean()) && std::isnan(a.max()));
+  a.add(-4);
+  EXPECT_EQ(a.max(), -4);  // a negative sample is the largest when it is the only one
+  a.add(10);
+  a.add(0.5);
+  EXPECT_DOUBLE_EQ(a.mean(), 6.5 / 3);
+  EXPECT_EQ(a.max(), 10);
+  a.clear();
+  EXPECT_TRUE(std::isnan(a.mean()) && std::isnan(a.max()));
+  a.add(1);
+  EXPECT_EQ(a.max(), 1);
 }
 
 TEST(Percentiles, AQuantileOutsideZeroToOneIsRejected) {

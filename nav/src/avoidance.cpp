@@ -374,7 +374,8 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
       if (have_prev_pt_ && dt > 1e-6 && dt < 0.5 && (world - prev_pt_).norm() < 0.3) {
         const Eigen::Vector2d vel = (world - prev_pt_) / dt;
         const Eigen::Vector2d los = (world - robot).normalized();
-        const double rate = -vel.dot(los);  // > 0: coming towards the robot
+        double rate = -vel.dot(los);  // > 0: coming towards the robot
+        if (rate > 0 && moved_in_ && !moved_in_(world)) rate = 0;  // static: it slid
         approach_ = 0.6 * approach_ + 0.4 * std::clamp(rate, -2.0, 2.0);
       } else {
         approach_ *= 0.5;

@@ -176,7 +176,10 @@ struct Writer {
     j["section"] = e.section;
     return "detour_start";
   }
-  const char* operator()(const event::DetourEnd&) { return "detour_end"; }
+  const char* operator()(const event::DetourEnd& e) {
+    j["reason"] = e.reason;
+    return "detour_end";
+  }
   const char* operator()(const event::RecoverStart& e) {
     j["direction_deg"] = e.direction_deg;
     return "recover_start";

@@ -230,7 +230,7 @@ struct Executive::Impl {
   hw::Intrinsics K;
   double frame_stamp = -1e300;
   int frames = 0, processed = 0, manoeuvres = 0, missed_in_row = 0;
-  double perc_sum = 0, perc_max = 0, objn_sum = 0, feat_sum = 0, match_sum = 0;
+  double objn_sum = 0, feat_sum = 0, match_sum = 0;  // over every processed frame
   int full_passes = 0, tracked_detections = 0;
   // Loop rates and latency budget (LoopTiming): counts, and samples added as they happen
   // (no lock: the executive runs on one thread).
@@ -287,8 +287,6 @@ struct Executive::Impl {
   Impl(mapsketch::Route r, Devices d, Perception& p, NavSettings st, ExecutiveObserver* o)
       : tracker(std::move(r), st.sections),
         goal_checker(st.sections.goal_radius_m),
-        progress_checker(st.exec.stuck_s, st.exec.stuck_m),
-        settle_checker(st.exec.goal_settle_m, st.exec.goal_settle_s),
         dev(d),
         perception(p),
         s(st),
@@ -300,7 +298,9 @@ struct Executive::Impl {
         planner(st.planner),
         movers(st.movers),
         grid_before(st.planner),
-        grid_snap(st.planner) {
+        grid_snap(st.planner),
+        progress_checker(st.exec.stuck_s, st.exec.stuck_m),
+        settle_checker(st.exec.goal_settle_m, st.exec.goal_settle_s) {
     s.exec.validate();
     s.select.validate();
     s.locate.validate();
@@ -313,6 +313,8 @@ struct Executive::Impl {
     if (dev.camera) K = dev.camera->intrinsics();
     if (dev.camera) half_fov = std::atan2(0.5 * K.width, K.fx);
     for (const auto& sec : tracker.route().sections) tracks.emplace_back(sec.landmarks.size());
+    if (s.avoid.approach_needs_free_floor)
+      avoider.setMovedInTest([this](const Eigen::Vector2d& p) { return grid_before.seenFree(p); });
   }
 
   void event(EventData d) {
@@ -606,10 +608,8 @@ struct Executive::Impl {
       }
       if (pt.track_steps > 0) track_ms.add(pt.track_ms);
       tracked_frames += pt.tracked > 0 ? 1 : 0;
-      perc_sum += ob.timing.total_ms;
       full_passes += ob.timing.full_pass ? 1 : 0;
       tracked_detections += ob.timing.tracked;
-      perc_max = std::max(perc_max, ob.timing.total_ms);
       objn_sum += ob.timing.objectness_ms;
       feat_sum += ob.timing.features_ms;
       match_sum += ob.timing.match_ms;
@@ -783,7 +783,7 @@ struct Executive::Impl {
         docking = true;
         if (avoider.active()) {
           avoider.reset();
-          endDetour();
+          endDetour("docking");
           event(event::AvoidEnd{DodgeSide::None, true});
         }
         target_bearing = bearing;
@@ -839,6 +839,7 @@ struct Executive::Impl {
     double front = 0;
     bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
     if (docking || recovering) {
+      endDetour(docking ? "docking" : "recovering");
       if (docking) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
     } else if (!dev.ranges.empty()) {
       avoider.setPose(pose);
@@ -858,7 +859,7 @@ struct Executive::Impl {
           passLandmark(att[0].k, att[0].i, false);
       }
       if (av.ended) {
-        endDetour();
+        if (!s.exec.detour_hold) endDetour("avoid ended");
         event(event::AvoidEnd{av.side});
       }
       if (av.active) {
@@ -888,12 +889,37 @@ struct Executive::Impl {
           c.turn = turnOf(c.w);
           arb.propose(Behaviour::Detour, c);
         } else {
-          endDetour();
+          endDetour(moving_seen ? "coming towards the robot" : "no way found");
           arb.propose(Behaviour::Avoid, {av.v, av.w, turnOf(av.w)});
         }
+      } else if (detouring && !servoing) {
+        // The avoider has let go (the corridor towards the route is free release_m ahead),
+        // but round a box or through a door that is before the robot is past it: heading
+        // back to the route from here drives into the same obstacle again. The detour is
+        // followed until the straight line to the route point it leads to is clear.
+        const Eigen::Vector2d to = tracker.lookahead(pose, s.exec.detour_ahead_m);
+        const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
+        const double b = planTowards(to);
+        if (planner.segmentClear({pose.x, pose.y}, to, hwid)) {
+          endDetour("route clear");
+          arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
+        } else if (!std::isfinite(b)) {
+          endDetour("no way found");
+          arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
+        } else {
+          dodging = true;
+          Command c;
+          headFor(b, 1.0, c.v, c.w);
+          c.v = avoider.capSpeed(scans, c.v);
+          c.turn = turnOf(c.w);
+          arb.propose(Behaviour::Detour, c);
+        }
       } else {
+        if (servoing) endDetour("servoing");
         arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
       }
+    } else {
+      endDetour("no range data");
     }
     sideLook(att.empty() ? nullptr : &att[0], docking || recovering, dodging && moving_seen, arb);
     // An end point that cannot be reached (the sketch put it in or against an obstacle): when
@@ -1103,10 +1129,10 @@ struct Executive::Impl {
         LocalPlanner::carrot(detour, {pose.x, pose.y}, planner.params().carrot_m);
     return polarFrom(pose, c).bearing;
   }
-  void endDetour() {
+  void endDetour(const char* reason) {
     if (!detouring) return;
     detouring = false;
-    event(event::DetourEnd{});
+    event(event::DetourEnd{reason});
   }
 
   // At the goal: whether to stay and look for a never-seen landmark of the last section within
@@ -1433,12 +1459,12 @@ ExecutiveSummary Executive::summary() const {
   s.frames = I.frames;
   s.frames_processed = I.processed;
   if (I.processed > 0) {
-    s.perception_ms_mean = I.perc_sum / I.processed;
+    s.perception_ms_mean = I.perception_ms.mean();
     s.objectness_ms_mean = I.objn_sum / I.processed;
     s.features_ms_mean = I.feat_sum / I.processed;
     s.match_ms_mean = I.match_sum / I.processed;
   }
-  s.perception_ms_max = I.perc_max;
+  if (!I.perception_ms.empty()) s.perception_ms_max = I.perception_ms.max();
   s.full_passes = I.full_passes;
   s.tracked_detections = I.tracked_detections;
   LoopTiming& lt = s.timing;

@@ -27,6 +27,8 @@ void PlannerParams::validate() const {
   require(max_insert_m > 0.5, "nav.planner.max_insert_m", "must be > 0.5 m");
   require(window_margin_m >= 0.5 && window_margin_m <= 20, "nav.planner.window_margin_m",
           "must be in [0.5, 20] m");
+  require(max_window_margin_m >= window_margin_m && max_window_margin_m <= 40,
+          "nav.planner.max_window_margin_m", "must be in [window_margin_m, 40] m");
   require(goal_snap_m >= 0, "nav.planner.goal_snap_m", "must be >= 0");
   require(carrot_m > 0, "nav.planner.carrot_m", "must be > 0");
 }
@@ -115,16 +117,33 @@ bool LocalPlanner::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d&
 }
 
 PlannedPath LocalPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2d& goal) const {
+  // A small window first: most ways round are short, and the window's cost grows with its
+  // area. The way round a long blockage (a route drawn on the wrong side of a desk island)
+  // can lie metres outside it; then the search meets the window's edge and only a wider
+  // window can say whether there is a way.
+  double margin = params_.window_margin_m;
+  for (;;) {
+    bool hit_edge = false, searched = false;
+    PlannedPath out = planInWindow(from, goal, margin, hit_edge, searched);
+    out.window_margin_m = margin;
+    if (out.found || !hit_edge || margin >= params_.max_window_margin_m) {
+      out.enclosed = !out.found && searched && !hit_edge;
+      return out;
+    }
+    margin = std::min(2 * margin, params_.max_window_margin_m);
+  }
+}
+
+PlannedPath LocalPlanner::planInWindow(const Eigen::Vector2d& from, const Eigen::Vector2d& goal,
+                                       double margin_m, bool& hit_edge, bool& searched) const {
   const auto& P = params_;
   const double c = P.cell_m;
   PlannedPath out;
   out.goal = goal;
-  const double x0 = std::min(from.x(), goal.x()) - P.window_margin_m;
-  const double y0 = std::min(from.y(), goal.y()) - P.window_margin_m;
-  const int W =
-      static_cast<int>(std::ceil((std::max(from.x(), goal.x()) + P.window_margin_m - x0) / c));
-  const int H =
-      static_cast<int>(std::ceil((std::max(from.y(), goal.y()) + P.window_margin_m - y0) / c));
+  const double x0 = std::min(from.x(), goal.x()) - margin_m;
+  const double y0 = std::min(from.y(), goal.y()) - margin_m;
+  const int W = static_cast<int>(std::ceil((std::max(from.x(), goal.x()) + margin_m - x0) / c));
+  const int H = static_cast<int>(std::ceil((std::max(from.y(), goal.y()) + margin_m - y0) / c));
   auto centre = [&](int col, int row) {
     return Eigen::Vector2d(x0 + (col + 0.5) * c, y0 + (row + 0.5) * c);
   };
@@ -177,6 +196,7 @@ PlannedPath LocalPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2
     out.goal_moved = true;
   }
 
+  searched = true;
   // A* over 8-connected cells; a step costs its length times the clearance penalty of the
   // cell it enters, and the straight-line distance is an admissible estimate.
   const int N = W * H;
@@ -204,6 +224,7 @@ PlannedPath LocalPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2
       break;
     }
     const int col = cur % W, row = cur / W;
+    if (col == 0 || row == 0 || col == W - 1 || row == H - 1) hit_edge = true;
     for (int k = 0; k < 8; ++k) {
       const int nc = col + dc[k], nr = row + dr[k];
       if (nc < 0 || nr < 0 || nc >= W || nr >= H) continue;
@@ -220,7 +241,20 @@ PlannedPath LocalPlanner::plan(const Eigen::Vector2d& from, const Eigen::Vector2
       }
     }
   }
-  if (!reached) return out;
+  if (!reached) {
+    // The robot's side met the window's edge; the goal's side may still be walled in (a goal
+    // inside a closed pen), and then no wider window helps either.
+    if (hit_edge) {
+      cv::Mat pass(H, W, CV_8U, cv::Scalar(0));
+      for (int row = 0; row < H; ++row)
+        for (int col = 0; col < W; ++col)
+          if (passable(col, row)) pass.at<uchar>(row, col) = 255;
+      cv::Rect r;
+      cv::floodFill(pass, g, cv::Scalar(128), &r, cv::Scalar(), cv::Scalar(), 8);
+      if (r.x > 0 && r.y > 0 && r.x + r.width < W && r.y + r.height < H) hit_edge = false;
+    }
+    return out;
+  }
   std::vector<Eigen::Vector2d> rev;
   double min_cl = 1e300;
   for (int i = gi; i >= 0; i = parent[i]) {

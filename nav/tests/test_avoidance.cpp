@@ -103,6 +103,59 @@ TEST(Avoider, StepsAwayFromSomeoneComingTowardsItOffToOneSide) {
   }
 }
 
+namespace {
+// A laser scan from a robot at the origin with heading `th` of a wall along x = 1 (world).
+hw::RangeScan wallAhead(double th) {
+  hw::RangeScan s;
+  s.kind = hw::RangeScan::Kind::Laser;
+  s.min_range = 0.05f;
+  s.max_range = 8.0f;
+  for (int i = -120; i <= 120; ++i) {
+    const double a = i * M_PI / 180, c = std::cos(th + a);
+    s.angles.push_back(static_cast<float>(a));
+    s.ranges.push_back(static_cast<float>(c > 1.0 / 8 ? 1.0 / c : 8.0));
+  }
+  return s;
+}
+// Turns the robot on the spot from -60 to 0 deg at 0.8 rad/s in front of the wall; the
+// largest approach estimate on the way.
+double approachWhileTurning(ObstacleAvoider& a) {
+  double worst = 0;
+  for (int k = 0; k <= 13; ++k) {
+    const double th = -M_PI / 3 + 0.08 * k, t = 0.1 * k;
+    a.setPose({0, 0, th});
+    auto scan = wallAhead(th);
+    scan.stamp = t;
+    worst = std::max(worst, a.step({scan}, 0.0, DodgeSide::None, th, 0.0, t).approach_speed);
+  }
+  return worst;
+}
+}  // namespace
+
+TEST(Avoider, AWallItTurnsInFrontOfIsNotComingTowardsIt) {
+  // The nearest point of the wall slides along it towards the robot as the robot turns to
+  // face it: on its own that reads as something coming at ~1 m/s.
+  ObstacleAvoider plain;
+  EXPECT_GT(approachWhileTurning(plain), 0.25);
+  // Told where the floor was seen free before (everything short of the wall), the wall's
+  // points are static: no approach.
+  ObstacleAvoider told;
+  told.setMovedInTest([](const Eigen::Vector2d& p) { return p.x() < 0.9; });
+  EXPECT_LT(approachWhileTurning(told), 0.1);
+  // A person walking at the robot over that floor is still coming towards it.
+  ObstacleAvoider person;
+  person.setMovedInTest([](const Eigen::Vector2d& p) { return p.x() < 0.9 || p.x() > 1.1; });
+  person.setPose({0, 0, 0});
+  AvoidOutput out;
+  for (int k = 0; k < 30 && !out.active; ++k) {
+    auto scan = laser({{3.0 - 0.05 * k, -0.3, 0.25}});
+    scan.stamp = 0.1 * k;
+    out = person.step({scan}, 0.0, DodgeSide::Right, 0.0, 0.0, 0.1 * k);
+  }
+  ASSERT_TRUE(out.active);
+  EXPECT_GT(out.approach_speed, 0.25);
+}
+
 TEST(Avoider, StepsOutOfAWalkersLaneNotAlongIt) {
   // A person walks at the robot 0.3 m left of its heading, which is the route's direction: the
   // dodge (to the right, away from them) heads at least half the walker side-bias off the

@@ -169,6 +169,48 @@ TEST(Executive, AvoidsAStaticObstacleOnThePath) {
   EXPECT_LT(s.distToGoal(), 0.6);
 }
 
+namespace {
+// A barrier 2.9 m wide across the first section at x = 3 (a row of touching discs): the
+// reactive avoider lets go as soon as the corridor towards the route is free release_m ahead,
+// well before the robot is past the barrier's end.
+void addBarrier(FakeWorld& w) {
+  for (double y = -1.25; y <= 1.26; y += 0.25) w.obstacles.push_back({{3.0, y}, 0.15});
+}
+std::vector<std::string> detourEndReasons(const Recorder& r) {
+  std::vector<std::string> out;
+  for (const auto& e : r.events)
+    if (std::string(e.type()) == "detour_end") out.push_back(e.toJson().value("reason", std::string()));
+  return out;
+}
+}  // namespace
+
+TEST(Executive, FollowsADetourPastTheObstacleNotOnlyWhileTheAvoiderDodges) {
+  Scenario s;
+  addBarrier(s.world);
+  const auto sum = s.run();
+  ASSERT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_LT(s.distToGoal(), 0.6);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+  ASSERT_GE(sum.detours, 1);
+  const auto reasons = detourEndReasons(s.rec);
+  for (const auto& r : reasons) EXPECT_NE(r, "avoid ended");
+  // The first detour ends because the way back to the route is clear: the robot is past the
+  // barrier's end.
+  ASSERT_FALSE(reasons.empty());
+  EXPECT_EQ(reasons.front(), "route clear");
+
+  // Ending with the avoider's manoeuvre (the behaviour before detour_hold), the first detour
+  // ends while the robot is still in front of the barrier.
+  Scenario off;
+  addBarrier(off.world);
+  off.settings.exec.detour_hold = false;
+  const auto sum_off = off.run();
+  const auto reasons_off = detourEndReasons(off.rec);
+  ASSERT_FALSE(reasons_off.empty());
+  EXPECT_EQ(reasons_off.front(), "avoid ended");
+  EXPECT_GE(sum_off.detours, sum.detours);
+}
+
 // Landmark B drawn 4 m short of where it stands (2.5 m up the second section instead of 1.5 m
 // past its end): seen about 16 deg from where the sketch puts it, at three times the predicted
 // range, so its range never agrees. B's class is drawn once, so its detection is taken for its

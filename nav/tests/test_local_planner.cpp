@@ -110,8 +110,38 @@ TEST(LocalPlanner, EnclosedGoalIsNotFound) {
   boxes.push_back({3.5, 0, 0.05, 1.5});
   boxes.push_back({6.5, 0, 0.05, 1.5});
   look(p, {{0, 0, 0}, {1, 2.2, 0}, {1, -2.2, 0}, {7.5, 2.2, M_PI}, {7.5, -2.2, M_PI}}, boxes);
-  EXPECT_FALSE(p.plan({0, 0}, {5, 0}).found);
+  const auto pen = p.plan({0, 0}, {5, 0});
+  EXPECT_FALSE(pen.found);
+  EXPECT_TRUE(pen.enclosed);  // proven: the search ran out of cells before the window's edge
+  EXPECT_EQ(pen.window_margin_m, p.params().window_margin_m);  // so no wider window was tried
   EXPECT_TRUE(p.plan({0, 0}, {7.5, 0}).found);
+}
+
+TEST(LocalPlanner, WidensTheWindowToFindTheWayRoundALongBlockage) {
+  // A hall 30 x 24 m; a partition across the straight line, 11 m long, with the way round
+  // its ends 5.5 m to either side: outside the first window (3 m round start and goal).
+  const std::vector<Box> hall = {
+      {3, -12, 15, 0.05}, {3, 12, 15, 0.05}, {-12, 0, 0.05, 12}, {18, 0, 0.05, 12}};
+  auto boxes = hall;
+  boxes.push_back({3, 0, 0.05, 5.5});
+  LocalPlanner p;
+  look(p, {{0, 0, 0}, {0, 4, 0}, {0, -4, 0}, {6, 0, M_PI}, {6, 4, M_PI}, {6, -4, M_PI}}, boxes);
+  const auto path = p.plan({0, 0}, {6, 0});
+  ASSERT_TRUE(path.found);
+  EXPECT_GT(path.window_margin_m, p.params().window_margin_m);
+  EXPECT_GT(path.length_m, 2 * std::hypot(3, 5.5));  // round an end, not through
+  double worst = 1e9;
+  for (const auto& q : path.points) worst = std::min(worst, minDistToBox(q, boxes.back()));
+  EXPECT_GE(worst, p.params().robot_radius_m);
+
+  // Limited to the first window, there is no way, and none is claimed proven.
+  PlannerParams narrow;
+  narrow.max_window_margin_m = narrow.window_margin_m;
+  LocalPlanner q(narrow);
+  look(q, {{0, 0, 0}, {0, 4, 0}, {0, -4, 0}, {6, 0, M_PI}, {6, 4, M_PI}, {6, -4, M_PI}}, boxes);
+  const auto none = q.plan({0, 0}, {6, 0});
+  EXPECT_FALSE(none.found);
+  EXPECT_FALSE(none.enclosed);
 }
 
 TEST(LocalPlanner, MovedObstacleIsErased) {

@@ -5,6 +5,7 @@
 #include <nlohmann/json.hpp>
 
 #include <cstddef>
+#include <limits>
 #include <vector>
 
 namespace sketchnav {
@@ -20,7 +21,14 @@ class PercentileAccumulator {
   void add(double x);
   std::size_t count() const { return samples_.size(); }
   bool empty() const { return samples_.empty(); }
-  void clear() { samples_.clear(); }
+  void clear() {
+    samples_.clear();
+    sum_ = 0;
+    max_ = -std::numeric_limits<double>::infinity();
+  }
+  /// Mean and largest of the samples, O(1); NaN when empty.
+  double mean() const;
+  double max() const;
 
   /// The percentiles reported: nearest rank over the samples so far; all NaN when n == 0.
   struct Summary {
@@ -39,6 +47,8 @@ class PercentileAccumulator {
 
  private:
   std::vector<double> samples_;
+  double sum_ = 0;
+  double max_ = -std::numeric_limits<double>::infinity();
 };
 
 /// The nearest-rank quantile of `sorted` (ascending), as PercentileAccumulator::quantile.

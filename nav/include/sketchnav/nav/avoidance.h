@@ -11,6 +11,7 @@
 // closer than `min_clearance_m` in the direction of motion the forward speed is zero.
 #include <Eigen/Core>
 
+#include <functional>
 #include <memory>
 #include <string>
 #include <vector>
@@ -47,6 +48,9 @@ struct AvoidParams {
   double approach_horizon_s = 3.0;   // [s] an obstacle coming towards the robot (a pedestrian)
                                      // triggers this much earlier (its speed x horizon)
   double reverse_speed = 0.12;       // [m/s] back-off speed when something keeps coming closer
+  // In the executive: the approach estimate counts only points on floor the occupancy grid
+  // had seen free 1.5-3 s before (ObstacleAvoider::setMovedInTest); false = every point.
+  bool approach_needs_free_floor = true;
   // Someone walking towards the robot is followed from scan to scan (a person-sized group of
   // laser points, with its velocity) for as long as it is in view, not only while it closes
   // the corridor ahead. While its lane (its straight path over lane_horizon_s, as wide as
@@ -77,6 +81,7 @@ struct AvoidParams {
     b("k_heading", k_heading);
     b("approach_horizon_s", approach_horizon_s);
     b("reverse_speed", reverse_speed);
+    b("approach_needs_free_floor", approach_needs_free_floor);
     b("lane_horizon_s", lane_horizon_s);
     b("person_radius_m", person_radius_m);
     b("lane_margin_m", lane_margin_m);
@@ -143,6 +148,15 @@ class ObstacleAvoider {
   /// walker coming at the robot from the side while it servoes on a landmark beside their
   /// lane). The avoider's own detection sees only what closes the corridor ahead.
   void offerWalker(const Eigen::Vector2d& position, const Eigen::Vector2d& velocity);
+  /// Whether a point (odometry frame) lies where the floor was seen free a few seconds ago
+  /// (the occupancy grid's memory, movers.h). Set, the point followed for the approach
+  /// estimate counts as coming towards the robot only there: the nearest point of a wall or a
+  /// door frame slides along its surface as the robot turns, and on an oblique surface that
+  /// sliding reads as an approach (static offices had detours ended "coming towards the
+  /// robot" with nobody in them). Unset: every point counts.
+  void setMovedInTest(std::function<bool(const Eigen::Vector2d&)> moved_in) {
+    moved_in_ = std::move(moved_in);
+  }
   bool active() const { return active_; }
   void reset();
   const AvoidParams& params() const { return params_; }
@@ -167,6 +181,7 @@ class ObstacleAvoider {
   Eigen::Vector2d prev_pt_{0, 0};  // nearest obstacle point ahead at the last scan (odometry)
   double prev_pt_t_ = 0;
   bool have_prev_pt_ = false;
+  std::function<bool(const Eigen::Vector2d&)> moved_in_;
   // The walker followed (odometry frame): centre of its laser points, filtered velocity.
   struct Walker {
     bool valid = false;

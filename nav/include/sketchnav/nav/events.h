@@ -140,7 +140,10 @@ struct DetourStart {
   bool goal_moved = false;
   int section = 0;
 };
-struct DetourEnd {};
+struct DetourEnd {
+  std::string reason;  // route clear | no way found | coming towards the robot | servoing |
+                       // docking | recovering | avoid ended | no range data
+};
 struct RecoverStart {
   double direction_deg = 0;  // robot frame
 };

@@ -139,6 +139,12 @@ struct ExecutiveParams {
   bool fovea_hints = true;
   bool detour = true;
   double detour_ahead_m = 3.0;  // [m]
+  // A detour once started is followed until the straight line to that route point is clear
+  // on the grid (or no way is found, someone comes towards the robot, or the servo takes
+  // over), not only while the reactive avoider is dodging: the avoider lets go when the
+  // corridor towards the route is free avoid.release_m ahead, which round a box or a door
+  // frame comes before the robot is past it. false = ends with the avoider's manoeuvre.
+  bool detour_hold = true;
   double replan_s = 0.5;        // [s]
   template <class B>
   void bind(B& b) {
@@ -195,6 +201,7 @@ struct ExecutiveParams {
     b("fovea_hints", fovea_hints);
     b("detour", detour);
     b("detour_ahead_m", detour_ahead_m);
+    b("detour_hold", detour_hold);
     b("replan_s", replan_s);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."

@@ -34,6 +34,8 @@ struct PlannerParams {
   double occupied_p = 0.65;      // occupancy probability above which a cell is an obstacle
   double max_insert_m = 6.0;     // [m] laser readings further than this do not mark the grid
   double window_margin_m = 3.0;  // [m] planning window: box round start and goal plus this
+  double max_window_margin_m = 12.0;  // [m] with no way found and the search stopped by the
+                                      // window's edge, the margin doubles up to this
   double goal_snap_m = 1.0;      // [m] a goal within an obstacle's clearance moves to the
                                  // nearest clear cell at most this far
   double carrot_m = 0.7;         // [m] path-following look-ahead
@@ -48,6 +50,7 @@ struct PlannerParams {
     b("occupied_p", occupied_p);
     b("max_insert_m", max_insert_m);
     b("window_margin_m", window_margin_m);
+    b("max_window_margin_m", max_window_margin_m);
     b("goal_snap_m", goal_snap_m);
     b("carrot_m", carrot_m);
   }
@@ -61,6 +64,9 @@ struct PlannedPath {
   Eigen::Vector2d goal{0, 0};  // where the path ends (the goal, or where it was moved to)
   bool goal_moved = false;     // the goal was within an obstacle's clearance
   double min_clearance_m = 0;  // smallest obstacle clearance along the path
+  double window_margin_m = 0;  // [m] margin of the window the search ended in
+  bool enclosed = false;       // not found, and provably so: the search ran out of cells
+                               // inside the window without reaching its edge (walled in)
 };
 
 class LocalPlanner {
@@ -73,8 +79,10 @@ class LocalPlanner {
   /// Adds a scan taken at `robot` (odometry frame). Laser scans only: a sonar cone says that
   /// something is somewhere across it, too vague to mark cells.
   void insert(const hw::Pose2D& robot, const hw::RangeScan& scan);
-  /// Plans from `from` to `goal` (odometry frame). Not found: the goal is enclosed, or no
-  /// clear cell lies within goal_snap_m of it.
+  /// Plans from `from` to `goal` (odometry frame) in a window round both, widening it (the
+  /// margin doubles from window_margin_m to max_window_margin_m) while the search is stopped
+  /// by the window's edge. Not found: no clear cell lies within goal_snap_m of the goal, the
+  /// robot or the goal is walled in (`enclosed`), or the way lies beyond the widest window.
   PlannedPath plan(const Eigen::Vector2d& from, const Eigen::Vector2d& goal) const;
   /// The straight segment keeps `clearance` [m] from every obstacle cell.
   bool segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b, double clearance) const;
@@ -94,6 +102,8 @@ class LocalPlanner {
   const PlannerParams& params() const { return params_; }
 
  private:
+  PlannedPath planInWindow(const Eigen::Vector2d& from, const Eigen::Vector2d& goal,
+                           double margin_m, bool& hit_edge, bool& searched) const;
   struct Impl;
   PlannerParams params_;
   std::unique_ptr<Impl> impl_;
