@@ -314,7 +314,15 @@ struct Executive::Impl {
     if (dev.camera) half_fov = std::atan2(0.5 * K.width, K.fx);
     for (const auto& sec : tracker.route().sections) tracks.emplace_back(sec.landmarks.size());
     if (s.avoid.approach_needs_free_floor)
-      avoider.setMovedInTest([this](const Eigen::Vector2d& p) { return grid_before.seenFree(p); });
+      avoider.setMovedInTest([this](const Eigen::Vector2d& p) {
+        // The point and its neighbours one cell round: a static surface's point often falls
+        // in the free cell in front of the wall's own cells.
+        const double c = grid_before.params().cell_m;
+        for (int i = -1; i <= 1; ++i)
+          for (int j = -1; j <= 1; ++j)
+            if (!grid_before.seenFree(p + Eigen::Vector2d(i * c, j * c))) return false;
+        return true;
+      });
   }
 
   void event(EventData d) {
@@ -1009,6 +1017,9 @@ struct Executive::Impl {
       const double w = std::abs(b) < 0.1 ? 0.0 : s.exec.k_heading * b;
       arb.propose(Behaviour::FinalLook, {0.0, w, turnOf(w)});
     }
+    // Behind someone walking the same way, whatever drives: keep the following gap.
+    if (!dev.ranges.empty() && arb.winner().v > 0)
+      arb.setWinnerSpeed(movers.followSpeed(pose, arb.winner().v));
     const Command& cmd = arb.winner();
     const Mode mode = modeOf(arb.winning());
     const servo::Turn turn = cmd.turn;

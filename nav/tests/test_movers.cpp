@@ -140,3 +140,27 @@ TEST(Movers, LanesOffByDefaultAndThenNoAdviceButStillTracked) {
   p.min_updates = 1;
   EXPECT_THROW(MoverTracker{p}, InputError);
 }
+
+TEST(Movers, BehindSomeoneWalkingTheSameWayTheRobotKeepsTheFollowingGap) {
+  // Someone walks away from the robot at 0.4 m/s and is 1.6 m ahead (1.1 m between the
+  // bodies, 1.5 m wanted): the robot may go at 0.4 - 0.4 / 2 = 0.2 m/s, not its 0.3 m/s.
+  LocalPlanner g1, g2, g3, g4;
+  const hw::Pose2D robot{0, 0, 0};
+  const auto ahead = watch(g1, robot, {1.0, 0.0}, {0.4, 0.0}, 1.5);
+  EXPECT_NEAR(ahead.followSpeed(robot, 0.3), 0.2, 0.06);
+  EXPECT_EQ(ahead.followSpeed(robot, 0.0), 0.0);
+  // Facing away from them, nothing to follow.
+  EXPECT_EQ(ahead.followSpeed({0, 0, M_PI}, 0.3), 0.3);
+  // Far enough ahead: the gap closes at the robot's own speed.
+  const auto far = watch(g2, robot, {2.0, 0.0}, {0.4, 0.0}, 1.5);
+  EXPECT_EQ(far.followSpeed(robot, 0.3), 0.3);
+  // Beside the robot's way, or coming towards it (the avoider's case): not followed.
+  const auto beside = watch(g3, robot, {1.0, 1.2}, {0.4, 0.0}, 1.5);
+  EXPECT_EQ(beside.followSpeed(robot, 0.3), 0.3);
+  const auto coming = watch(g4, robot, {3.0, 0.0}, {-0.4, 0.0}, 1.0);
+  EXPECT_EQ(coming.followSpeed(robot, 0.3), 0.3);
+  // Off.
+  MoverParams off;
+  off.follow_gap_m = 0;
+  EXPECT_EQ(MoverTracker(off).followSpeed(robot, 0.3), 0.3);
+}

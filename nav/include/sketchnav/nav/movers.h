@@ -41,6 +41,12 @@ struct MoverParams {
   double robot_radius_m = 0.2;   // [m]
   double look_ahead_s = 1.5;     // [s] the robot's own motion checked against lanes
   double range_m = 4.0;          // [m] movers further than this are ignored
+  // Walking behind someone (followSpeed(), applied whether or not `enabled`): the robot keeps
+  // follow_gap_m between the two bodies, closing a larger gap at most at 1 / follow_time_s of
+  // the excess. A person who turns round then has seconds, not a metre, to be got out of the
+  // way of. 0 = off.
+  double follow_gap_m = 1.5;   // [m]
+  double follow_time_s = 2.0;  // [s]
   template <class B>
   void bind(B& b) {
     b("enabled", enabled);
@@ -56,6 +62,8 @@ struct MoverParams {
     b("robot_radius_m", robot_radius_m);
     b("look_ahead_s", look_ahead_s);
     b("range_m", range_m);
+    b("follow_gap_m", follow_gap_m);
+    b("follow_time_s", follow_time_s);
   }
   void validate() const;  // InputError "nav.movers.<field> = ...: ..."
 };
@@ -90,6 +98,10 @@ class MoverTracker {
   /// need not be: a person already walking when first in view (the lab's walker, seen first across
   /// the room) is first seen where the grid had not yet seen the floor.
   std::vector<Mover> walkers() const;
+  /// The forward speed at most `v` that keeps follow_gap_m behind a track walking away from
+  /// the robot in its way (ahead, within both bodies' width of its heading line, steady over
+  /// 2 x min_updates scans at 0.2-1.2 m/s). `v` when there is none.
+  double followSpeed(const hw::Pose2D& robot, double v) const;
   /// Advice for a robot at `robot` about to command (v, w): stop rather than enter a lane,
   /// step out of one it is in. `k_heading`, `v_max`: how it turns and how fast it may go.
   YieldAdvice advise(const hw::Pose2D& robot, double v, double w, double k_heading,
