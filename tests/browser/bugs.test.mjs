@@ -106,8 +106,15 @@ try {
 
   await check('2: double-click on a placed landmark opens the distance dialog', async () => {
     await page.keyboard.press('Escape').catch(() => {});
-    const r = await page.locator('.lm[data-id="L1"] rect.box').boundingBox();
-    await page.mouse.dblclick(r.x + r.width / 2, r.y + r.height / 2);
+    // Where the landmark is, from the page's own state: every press redraws the landmark's
+    // element, so a box measured from the DOM can belong to one already replaced (null).
+    await page.waitForSelector('.lm[data-id="L1"] rect.box');
+    const c = await page.evaluate(() => {
+      const l = state.landmarks.find((x) => x.id === 'L1');
+      return [l.x + l.w / 2, l.y + l.h / 2];
+    });
+    const [cx, cy] = await toScreen(...c);
+    await page.mouse.dblclick(cx, cy);
     await page.waitForSelector('#dist-dialog[open]', { timeout: 2000 });
     await page.fill('#dist-input', '4');
     await page.keyboard.press('Enter');
