@@ -443,6 +443,12 @@ bool mountOf(const std::string& frame, double timeout_s, double& x, double& y, d
     const auto& q = t.transform.rotation;
     double r, p;
     tf2::Matrix3x3(tf2::Quaternion(q.x, q.y, q.z, q.w)).getRPY(r, p, yaw);
+    // tf2 refuses NaN and denormalised rotations when they are published; a mount that is
+    // still not finite here would put every beam nowhere: garbage, and a stop.
+    if (!std::isfinite(x) || !std::isfinite(y) || !std::isfinite(yaw)) {
+      detail::garbage("tf " + base + " -> " + frame + ": the sensor mount is not finite");
+      return false;
+    }
     return true;
   } catch (const std::exception&) {
     return false;

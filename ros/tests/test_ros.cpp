@@ -496,6 +496,19 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
       sensor_msgs::LaserScan sc;
       sc.header.stamp = now;
       sc.header.frame_id = "base_link";
+      if (b && std::string(g.name) == "nan_laser_mount") {
+        // The laser moves to its own frame, whose mount on the base is published NaN.
+        sc.header.frame_id = "laser_link";
+        geometry_msgs::TransformStamped t;
+        t.header.stamp = now;
+        t.header.frame_id = "base_link";
+        t.child_frame_id = "laser_link";
+        t.transform.translation.x = not_a_number;
+        t.transform.rotation.w = 1;
+        tf2_msgs::TFMessage tf;
+        tf.transforms.push_back(t);
+        tf_pub.publish(tf);
+      }
       sc.angle_min = -1.0f;
       sc.angle_max = 1.0f;
       sc.angle_increment = 0.01f;
@@ -555,6 +568,10 @@ INSTANTIATE_TEST_SUITE_P(
                               "odometry (tf odom -> base_link): rotation is a zero quaternion",
                               nullptr, true},
                       Garbage{"scan_wrong_length", "the scan has 50 ranges"},
+                      // tf2 refuses the NaN mount (nothing to look up): scans skipped, then
+                      // the range supervisor's stop; a NaN that got through: mountOf's own.
+                      Garbage{"nan_laser_mount", "no tf for the laser frame yet",
+                              "the sensor mount is not finite"},
                       Garbage{"frozen_camera", "camera on /image_raw: no message for",
                               // the executive's own check on ROS time, same 0.5 s limit
                               "safety stop: camera stale: no data for"},
