@@ -212,6 +212,56 @@ try {
     await page.selectOption('#world', 'corridor');
   });
 
+  await check('3: a floor plan loaded in the editor is saved with the sketch: reopened after a reload, it is there at the same scale', async () => {
+    await openEditor();
+    await openExample('lab');
+    await page.selectOption('#world', '');
+    await page.setInputFiles('#plan-file', planPng);
+    await page.waitForSelector('#layer-plan image.plan');
+    promptAnswer = '4';
+    for (const p of [[200, 350], [600, 350]]) { const sc = await toScreen(...p); await page.mouse.click(sc[0], sc[1]); }
+    await page.waitForFunction(() => plan && plan.scale);
+    const before = await page.evaluate(() => ({ scale: plan.scale, rect: plan.rect, href: plan.href, note: document.getElementById('bg-note').textContent, bar: document.getElementById('scale-bar-text').textContent }));
+    assert.ok(Math.abs(before.scale - 4 / 400) < 1e-9, `scale ${before.scale} m/px`);
+    await page.fill('#name', 'with-plan');
+    await page.click('#save');
+    await page.waitForFunction(() => /Saved/.test(document.getElementById('status').textContent));
+    // The file keeps the plan (image, where it is drawn, its scale and the measured points).
+    const file = JSON.parse(fs.readFileSync(path.join(sketchDir, 'with-plan.sketch.json'), 'utf8'));
+    assert.ok(file.floor_plan, 'floor_plan in the file');
+    assert.equal(file.floor_plan.m_per_px, before.scale);
+    assert.deepEqual(file.floor_plan.rect, before.rect);
+    assert.deepEqual(file.floor_plan.scale_points, [[200, 350], [600, 350]]);
+    assert.equal(file.floor_plan.image, before.href, 'the image as loaded');
+    // The route the robot follows is the same with or without it.
+    const noPlan = JSON.parse(execFileSync(sketchnav, ['--json', 'route', path.join(sketchDir, 'with-plan.sketch.json')]).toString());
+    assert.ok(noPlan.sections.length > 0, 'sketchnav route reads the file');
+    // A reload forgets the page; opening the sketch brings the plan back at the same scale.
+    await page.reload();
+    await page.waitForSelector('.class-card[data-class="Oatly-Oat-Milk"]');
+    assert.equal(await page.locator('#layer-plan image.plan').count(), 0, 'no plan after the reload');
+    await page.waitForSelector('#open option[value="sketches/with-plan.sketch.json"]', { state: 'attached' });
+    await page.selectOption('#open', 'sketches/with-plan.sketch.json');
+    await page.waitForSelector('#layer-plan image.plan');
+    await page.waitForFunction(() => route !== null);
+    const after = await page.evaluate(() => ({ scale: plan.scale, rect: plan.rect, href: plan.href, note: document.getElementById('bg-note').textContent, bar: document.getElementById('scale-bar-text').textContent,
+      img: (() => { const i = document.querySelector('#layer-plan image.plan'); return ['x', 'y', 'width', 'height'].map((k) => +i.getAttribute(k)); })() }));
+    assert.equal(after.scale, before.scale, 'same scale');
+    assert.deepEqual(after.rect, before.rect, 'same place');
+    assert.deepEqual(after.img, [before.rect.x, before.rect.y, before.rect.w, before.rect.h]);
+    assert.equal(after.href, before.href, 'same image');
+    assert.match(after.note, /floor plan: 1 m = 100\.0 px/);
+    assert.match(after.bar, /m \(floor plan\)$/);
+    assert.equal(await page.isDisabled('#plan-clear'), false);
+    await shot(page, 'editor-plan-reopened');
+    // Removing the plan and saving again leaves no floor_plan in the file.
+    await page.click('#plan-clear');
+    await page.click('#save');
+    await page.waitForFunction(() => /Saved/.test(document.getElementById('status').textContent));
+    assert.equal(JSON.parse(fs.readFileSync(path.join(sketchDir, 'with-plan.sketch.json'), 'utf8')).floor_plan, undefined);
+    await page.selectOption('#world', 'corridor');
+  });
+
   // ---- 5: the distance model ------------------------------------------------------------
   await check('5: each distance says what it counts from; reordering the route warns that a distance now counts from another landmark', async () => {
     await openEditor();
