@@ -262,6 +262,29 @@ try {
     await page.selectOption('#world', 'corridor');
   });
 
+  await check('8: the editor toolbar fits on one line at 1280x800', async () => {
+    await page.setViewportSize({ width: 1280, height: 800 });
+    await openEditor();
+    await openExample('lab');
+    const m = await page.evaluate(() => {
+      const bar = document.getElementById('toolbar');
+      const kids = [...bar.querySelectorAll('button, label')].filter((e) => e.getBoundingClientRect().width > 0);
+      // Lines: items whose vertical centres lie within half a button's height of each other.
+      const mids = kids.map((e) => { const r = e.getBoundingClientRect(); return (r.top + r.bottom) / 2; }).sort((a, b) => a - b);
+      const half = document.getElementById('undo').getBoundingClientRect().height / 2;
+      const tops = mids.filter((m, i) => i === 0 || m - mids[i - 1] > half);
+      const b = bar.getBoundingClientRect();
+      const btn = document.getElementById('undo').getBoundingClientRect();
+      const stage = document.getElementById('stage').getBoundingClientRect();
+      const rights = kids.map((e) => e.getBoundingClientRect().right);
+      return { h: b.height, btn: btn.height, lines: tops.length, widths: kids.map((e) => Math.round(e.getBoundingClientRect().width)), barW: b.width, right: Math.max(...rights), stageRight: stage.right, items: kids.length };
+    });
+    assert.equal(m.lines, 1, `toolbar items on ${m.lines} lines (widths ${m.widths}, toolbar ${m.barW} px)`);
+    assert.ok(m.h < 1.6 * m.btn, `toolbar ${m.h} px high, one button is ${m.btn} px`);
+    assert.ok(m.right <= m.stageRight + 0.5, `nothing sticks out (${m.right} > ${m.stageRight})`);
+    await shot(page, 'editor-1280', { clip: { x: 0, y: 0, width: 1280, height: 200 } });
+  });
+
   // ---- 5: the distance model ------------------------------------------------------------
   await check('5: each distance says what it counts from; reordering the route warns that a distance now counts from another landmark', async () => {
     await openEditor();
