@@ -410,7 +410,7 @@ try {
     await page.selectOption('#opt-detections', '1');
     await page.waitForFunction(() => /detections=1/.test(document.getElementById('camera-img').src));
     const legend = await page.$$eval('#map-legend li', (ls) => ls.filter((l) => l.getBoundingClientRect().height > 0).map((l) => l.textContent));
-    assert.deepEqual(legend, ['wall', 'obstacle', 'landmark (real)', 'landmark (sketched)', 'sketched path', 'trajectory (odometry)', 'robot', 'goal']);
+    assert.deepEqual(legend, ['wall', 'obstacle', 'landmark (real)', 'landmark (sketched)', 'sketched path', 'sketch as refitted', 'trajectory (odometry)', 'robot', 'goal']);
     await page.selectOption('#opt-windows', '20');
     await page.selectOption('#opt-detections', '-1');
     void s;
