@@ -120,10 +120,9 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     r.fail("format", "version " + std::to_string(s.format) +
                          " was written by a newer sketchnav (this one reads up to " +
                          std::to_string(kSketchFormat) + ")");
-  r.onlyKeys(
-      j, "",
-      {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal", "goal_place",
-       "floor_plan"});
+  r.onlyKeys(j, "",
+             {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal",
+              "goal_place", "floor_plan"});
   if (j.contains("name")) s.name = r.string(j["name"], "name");
   if (j.contains("notes")) s.notes = r.string(j["notes"], "notes");
 
@@ -188,7 +187,8 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     FloorPlan plan;
     const Json& image = r.member(fp, "floor_plan", "image");
     if (image.is_string() && image.get_ref<const std::string&>().size() > kMaxFloorPlanBytes)
-      r.fail("floor_plan.image", "too large (" + std::to_string(image.get_ref<const std::string&>().size()) +
+      r.fail("floor_plan.image", "too large (" +
+                                     std::to_string(image.get_ref<const std::string&>().size()) +
                                      " bytes > " + std::to_string(kMaxFloorPlanBytes) + ")");
     plan.image = r.string(image, "floor_plan.image");
     const Json& rect = r.member(fp, "floor_plan", "rect");
@@ -201,14 +201,14 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     if (fp.contains("m_per_px")) {
       plan.m_per_px = r.number(fp["m_per_px"], "floor_plan.m_per_px");
       if (plan.m_per_px <= 0)
-        r.fail("floor_plan.m_per_px", "= " + fmt(plan.m_per_px) + ": must be positive (leave it out for no scale)");
+        r.fail("floor_plan.m_per_px",
+               "= " + fmt(plan.m_per_px) + ": must be positive (leave it out for no scale)");
     }
     if (fp.contains("scale_points")) {
       const Json& sp = fp["scale_points"];
       r.array(sp, "floor_plan.scale_points");
       if (sp.size() != 2)
-        r.fail("floor_plan.scale_points",
-               "expected 2 points, got " + std::to_string(sp.size()));
+        r.fail("floor_plan.scale_points", "expected 2 points, got " + std::to_string(sp.size()));
       for (size_t i = 0; i < sp.size(); ++i)
         plan.scale_points.push_back(
             r.point(sp[i], "floor_plan.scale_points[" + std::to_string(i) + "]"));
@@ -300,8 +300,7 @@ void validateSketch(const Sketch& s, const std::string& origin) {
       const unsigned char c = static_cast<unsigned char>(fp.image[i]);
       const bool b64 = std::isalnum(c) || c == '+' || c == '/';
       if (c == '=' && ++pad <= 2) continue;
-      if (!b64 || pad > 0)
-        fail("floor_plan.image", "not base64 at byte " + std::to_string(i));
+      if (!b64 || pad > 0) fail("floor_plan.image", "not base64 at byte " + std::to_string(i));
     }
     if (fp.image.size() == data || (fp.image.size() - data) % 4 != 0)
       fail("floor_plan.image", "truncated base64 data");
@@ -321,7 +320,8 @@ void validateSketch(const Sketch& s, const std::string& origin) {
       for (size_t i = 0; i < 2; ++i) {
         const std::string f = "floor_plan.scale_points[" + std::to_string(i) + "]";
         if (!finite(fp.scale_points[i])) fail(f, "not a finite number");
-        if (!inside(fp.scale_points[i])) fail(f, ptxt(fp.scale_points[i]) + " is outside the canvas");
+        if (!inside(fp.scale_points[i]))
+          fail(f, ptxt(fp.scale_points[i]) + " is outside the canvas");
       }
     }
   }
@@ -394,8 +394,9 @@ Json sketchToJson(const Sketch& s) {
   if (s.goal_place.kind == GoalPlace::Kind::Doorway) j["goal_place"] = goalPlaceJson(s.goal_place);
   if (s.floor_plan) {
     const FloorPlan& fp = *s.floor_plan;
-    Json plan = {{"image", fp.image},
-                 {"rect", {{"x", fp.rect.x}, {"y", fp.rect.y}, {"w", fp.rect.w}, {"h", fp.rect.h}}}};
+    Json plan = {
+        {"image", fp.image},
+        {"rect", {{"x", fp.rect.x}, {"y", fp.rect.y}, {"w", fp.rect.w}, {"h", fp.rect.h}}}};
     if (fp.m_per_px > 0) plan["m_per_px"] = fp.m_per_px;
     if (!fp.scale_points.empty()) {
       Json pts = Json::array();

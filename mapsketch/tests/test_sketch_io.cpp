@@ -120,7 +120,8 @@ TEST(SketchIo, AFloorPlanRoundTripsWithItsScale) {
   fp.scale_points = {{100, 200}, {300, 200}};
   a.floor_plan = fp;
   const std::string text = sketchToText(a);
-  EXPECT_NE(text.find("\"floor_plan\": {\"rect\""), std::string::npos) << text.substr(text.size() - 400);
+  EXPECT_NE(text.find("\"floor_plan\": {\"rect\""), std::string::npos)
+      << text.substr(text.size() - 400);
   const Sketch b = sketchFromText(text);
   ASSERT_TRUE(b.floor_plan.has_value());
   EXPECT_EQ(b.floor_plan->image, kPlanPng);
@@ -142,7 +143,8 @@ TEST(SketchIo, AFloorPlanRoundTripsWithItsScale) {
 
 TEST(SketchValidation, ABadFloorPlanNamesTheField) {
   Json j = good();
-  const Json plan = {{"image", kPlanPng}, {"rect", {{"x", 0}, {"y", 0}, {"w", 1000}, {"h", 700}}},
+  const Json plan = {{"image", kPlanPng},
+                     {"rect", {{"x", 0}, {"y", 0}, {"w", 1000}, {"h", 700}}},
                      {"m_per_px", 0.02}};
   j["floor_plan"] = plan;
   EXPECT_NO_THROW(sketchFromJson(j));
@@ -157,7 +159,8 @@ TEST(SketchValidation, ABadFloorPlanNamesTheField) {
   expectError(j, {"floor_plan.image", "not base64"});
   j["floor_plan"]["image"] = "data:image/png;base64,iVB";
   expectError(j, {"floor_plan.image", "truncated"});
-  j["floor_plan"]["image"] = std::string("data:image/png;base64,") + std::string(kMaxFloorPlanBytes, 'A');
+  j["floor_plan"]["image"] =
+      std::string("data:image/png;base64,") + std::string(kMaxFloorPlanBytes, 'A');
   expectError(j, {"floor_plan.image", "too large"});
   j["floor_plan"] = plan;
   j["floor_plan"].erase("image");

@@ -86,8 +86,12 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
     h.on_event({0.0, nav::event::Start{3, 5.0}});
     // The route as refitted at a landmark fix (cmd_ui's PlacementReporter reports this).
     if (h.on_placement)
-      h.on_placement({{"path", {{0, 0.2}, {3, 0.2}, {3, 2.2}}}, {"refits", 1}, {"scale", 1.0},
-                      {"rotation_deg", 0.0}, {"start", {0, 0.2}}, {"t", 0.0}});
+      h.on_placement({{"path", {{0, 0.2}, {3, 0.2}, {3, 2.2}}},
+                      {"refits", 1},
+                      {"scale", 1.0},
+                      {"rotation_deg", 0.0},
+                      {"start", {0, 0.2}},
+                      {"t", 0.0}});
     std::string reason = "arrived";
     bool success = true;
     for (int i = 0; i < max_ticks; ++i) {

@@ -35,8 +35,8 @@ struct GoalPlace {
 /// A floor-plan image the sketch was traced over (the editor's *Floor plan…*), kept with the
 /// sketch for people; the robot never uses it. doc/sketch-format.md, "floor_plan".
 struct FloorPlan {
-  std::string image;  // a data URL: data:image/(png|jpeg|gif|webp|svg+xml);base64,...
-  CanvasRect rect;    // [canvas px] where the image is drawn (fitted inside, aspect kept)
+  std::string image;    // a data URL: data:image/(png|jpeg|gif|webp|svg+xml);base64,...
+  CanvasRect rect;      // [canvas px] where the image is drawn (fitted inside, aspect kept)
   double m_per_px = 0;  // [m per canvas px] the scale the user set on it; 0 = none
   std::vector<Eigen::Vector2d> scale_points;  // the two points it was measured between, or none
 };
