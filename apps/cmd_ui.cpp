@@ -6,6 +6,8 @@
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
+#include "sketchnav/nav/executive.h"
+#include "sketchnav/nav/sections.h"
 #include "sketchnav/sim/world.h"
 #include "run_api.h"
 
@@ -59,6 +61,75 @@ std::string sketchFor(const ui::RunRequest& rq) {
 
 Json worldGeometry(const std::string& world);
 
+// The drawn path in the route frame (metres; the frame of Route::guide_points_m).
+std::vector<Eigen::Vector2d> sketchPathInRoute(const mapsketch::Sketch& sk,
+                                               const mapsketch::Route& route) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(sk.path.size());
+  for (const auto& p : sk.path)
+    out.push_back(route.start_m + Eigen::Vector2d((p.x() - sk.start.x()) * route.scale_m_per_px,
+                                                  -(p.y() - sk.start.y()) * route.scale_m_per_px));
+  return out;
+}
+
+// The route as the executive places it now (its SectionTracker's route -> odometry
+// alignment, refitted at landmark fixes), for the run page's map. Called after every step;
+// reports only when the alignment or the observed goal changed.
+class PlacementReporter {
+ public:
+  /// `path_px`: the drawn path in sketch pixels from the start, y up (scaled by the route's
+  /// own scale when reported).
+  PlacementReporter(std::vector<Eigen::Vector2d> path_px, std::function<void(const Json&)> out)
+      : path_px_(std::move(path_px)), out_(std::move(out)) {}
+
+  void operator()(const nav::Executive& ex, double t) {
+    using V = Eigen::Vector2d;
+    const nav::SectionTracker& tr = ex.sections();
+    const mapsketch::Route& route = tr.route();
+    const V a = tr.toOdom(route.start_m), b = tr.toOdom(route.start_m + V(1, 0));
+    const std::optional<V> goal = tr.goalOdom();
+    auto same = [](const V& p, const V& q) { return (p - q).norm() < 1e-6; };
+    if (reported_ && same(a, a_) && same(b, b_) && goal.has_value() == goal_.has_value() &&
+        (!goal || same(*goal, *goal_)))
+      return;
+    if (reported_) ++refits_;
+    reported_ = true;
+    a_ = a;
+    b_ = b;
+    goal_ = goal;
+    auto pt = [](const V& p) { return Json::array({p.x(), p.y()}); };
+    Json path = Json::array(), guides = Json::array(), lms = Json::array();
+    for (const auto& p : path_px_)
+      path.push_back(pt(tr.toOdom(route.start_m + p * route.scale_m_per_px)));
+    for (const auto& p : tr.guidePointsOdom()) guides.push_back(pt(p));
+    for (const auto& sec : route.sections)
+      for (const auto& l : sec.landmarks) {
+        const V p = tr.toOdom(l.position_m);
+        lms.push_back({{"id", l.id}, {"x", p.x()}, {"y", p.y()}});
+      }
+    const V d = b - a;
+    // At the start the route is rotated by -start_heading and unscaled: report the change.
+    const double rot = wrapAngle(std::atan2(d.y(), d.x()) + route.start_heading_rad);
+    out_({{"path", path},
+          {"guide_points", guides},
+          {"landmarks", lms},
+          {"goal", pt(tr.endOdom(tr.count() - 1))},
+          {"rotation_deg", rot * 180.0 / M_PI},
+          {"scale", d.norm()},
+          {"start", pt(a)},
+          {"refits", refits_},
+          {"t", t}});
+  }
+
+ private:
+  std::vector<Eigen::Vector2d> path_px_;
+  std::function<void(const Json&)> out_;
+  bool reported_ = false;
+  int refits_ = 0;
+  Eigen::Vector2d a_{0, 0}, b_{0, 0};
+  std::optional<Eigen::Vector2d> goal_;
+};
+
 // What the page's map shows, in the odometry frame (origin at the start, x along the
 // robot's initial heading) where the executive's pose estimate lives: the sketch as the
 // executive aligns it (start on the robot, first section along its heading) and, in
@@ -77,11 +148,7 @@ Json mapGeometry(const ui::RunRequest& rq) {
       return V(c * d.x() - s * d.y(), s * d.x() + c * d.y());
     };
     Json path = Json::array();
-    for (const auto& p : sk.path) {
-      const V rp((p.x() - sk.start.x()) * route.scale_m_per_px,
-                 -(p.y() - sk.start.y()) * route.scale_m_per_px);
-      path.push_back(pt(toOdom(rp + route.start_m)));
-    }
+    for (const auto& p : sketchPathInRoute(sk, route)) path.push_back(pt(toOdom(p)));
     Json guides = Json::array(), lms = Json::array();
     for (const auto& p : route.guide_points_m) guides.push_back(pt(toOdom(p)));
     for (const auto& sec : route.sections)
@@ -200,6 +267,29 @@ Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::str
   o.on_observation = h.on_observation;
   o.stop_requested = h.stop_requested;
   o.out_dir = h.out_dir;  // the run folder `sketchnav run` writes, for the page's record
+  if (h.on_placement) {
+    // The refitted sketch on the map: read from the executive after each step (no change to
+    // what it does; runNavigation steps it itself whenever stop_requested is set anyway).
+    std::vector<Eigen::Vector2d> path_px;
+    try {
+      const std::string sp = sketchFor(rq);
+      if (!sp.empty() && fs::exists(sp)) {
+        const mapsketch::Sketch sk = mapsketch::loadSketch(sp);
+        for (const auto& p : sk.path)
+          path_px.emplace_back(p.x() - sk.start.x(), -(p.y() - sk.start.y()));
+      }
+    } catch (const std::exception&) {
+      // the run reports a bad sketch itself; the map then shows the guide points only
+    }
+    auto rep = std::make_shared<PlacementReporter>(std::move(path_px), h.on_placement);
+    auto last_t = std::make_shared<double>(0.0);
+    auto on_tick = o.on_tick;
+    o.on_tick = [on_tick, last_t](const nav::TelemetryRow& r) {
+      *last_t = r.t;
+      if (on_tick) on_tick(r);
+    };
+    o.after_step = [rep, last_t](const nav::Executive& ex) { (*rep)(ex, *last_t); };
+  }
   try {
     h.on_map(mapGeometry(rq));
   } catch (const std::exception& e) {

@@ -147,6 +147,7 @@ struct RunController::Live {
   std::map<std::string, Json> landmarks;  // id -> {id, class, section, state, ...}
   std::vector<std::pair<double, double>> trajectory;
   Json map_geometry;
+  Json placement;  // the route as the executive places it now (RunHooks::on_placement)
   // run record and progress
   std::string run_dir;  // this run's folder ("" = none)
   std::vector<std::array<double, 8>> ticks;  // t v w servo_error(NaN) x y theta section
@@ -192,6 +193,7 @@ struct RunController::Live {
     landmarks.clear();
     trajectory.clear();
     map_geometry = nullptr;
+    placement = nullptr;
     run_dir.clear();
     ticks.clear();
     obs.clear();
@@ -531,6 +533,10 @@ void RunController::runThread(RunRequest request) {
         if (p.is_array() && p.size() == 2)
           live->guides.emplace_back(p[0].get<double>(), p[1].get<double>());
   };
+  h.on_placement = [live](const Json& p) {
+    std::lock_guard<std::mutex> l(live->m);
+    live->placement = p;
+  };
   {
     std::lock_guard<std::mutex> l(live->m);
     h.out_dir = live->run_dir;
@@ -672,7 +678,7 @@ Json RunController::map() const {
   std::lock_guard<std::mutex> l(L.m);
   Json tr = Json::array();
   for (const auto& [x, y] : L.trajectory) tr.push_back({x, y});
-  Json m = {{"geometry", L.map_geometry}, {"trajectory", tr}};
+  Json m = {{"geometry", L.map_geometry}, {"trajectory", tr}, {"placement", L.placement}};
   m["pose"] = L.has_tick
                   ? Json{{"x", L.tick.odom.x}, {"y", L.tick.odom.y}, {"theta", L.tick.odom.theta}}
                   : Json(nullptr);

@@ -71,6 +71,10 @@ struct RunHooks {
   std::function<std::unique_ptr<hw::Base>(std::unique_ptr<hw::Base>)> wrap_base;
   std::function<bool()> stop_requested;     // polled every tick: true -> stop and end the run
   std::function<void(const Json&)> on_map;  // map geometry, once before the run starts
+  /// The route as the executive places it now (odometry frame), once at the start and again
+  /// whenever it refits the sketch to a landmark fix: {path, guide_points, landmarks, goal,
+  /// rotation_deg, scale, start, refits, t}. Optional.
+  std::function<void(const Json&)> on_placement;
   /// The run folder to write (summary.json, trajectory.png, telemetry.csv, events.jsonl, as
   /// `sketchnav run --out` does); "" = none (camera only, or no runs folder configured).
   std::string out_dir;

@@ -1,4 +1,5 @@
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -119,9 +120,9 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
     r.fail("format", "version " + std::to_string(s.format) +
                          " was written by a newer sketchnav (this one reads up to " +
                          std::to_string(kSketchFormat) + ")");
-  r.onlyKeys(
-      j, "",
-      {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal", "goal_place"});
+  r.onlyKeys(j, "",
+             {"format", "name", "notes", "canvas", "landmarks", "path", "start", "goal",
+              "goal_place", "floor_plan"});
   if (j.contains("name")) s.name = r.string(j["name"], "name");
   if (j.contains("notes")) s.notes = r.string(j["notes"], "notes");
 
@@ -178,6 +179,41 @@ Sketch sketchFromJson(const Json& j, const std::string& origin) {
       r.fail("goal_place.kind", "'" + kind + "' is not one of: point, doorway");
     if (g.contains("standoff_m"))
       s.goal_place.standoff_m = r.number(g["standoff_m"], "goal_place.standoff_m");
+  }
+  if (j.contains("floor_plan")) {
+    const Json& fp = j["floor_plan"];
+    r.object(fp, "floor_plan");
+    r.onlyKeys(fp, "floor_plan", {"image", "rect", "m_per_px", "scale_points"});
+    FloorPlan plan;
+    const Json& image = r.member(fp, "floor_plan", "image");
+    if (image.is_string() && image.get_ref<const std::string&>().size() > kMaxFloorPlanBytes)
+      r.fail("floor_plan.image", "too large (" +
+                                     std::to_string(image.get_ref<const std::string&>().size()) +
+                                     " bytes > " + std::to_string(kMaxFloorPlanBytes) + ")");
+    plan.image = r.string(image, "floor_plan.image");
+    const Json& rect = r.member(fp, "floor_plan", "rect");
+    r.object(rect, "floor_plan.rect");
+    r.onlyKeys(rect, "floor_plan.rect", {"x", "y", "w", "h"});
+    plan.rect.x = r.number(r.member(rect, "floor_plan.rect", "x"), "floor_plan.rect.x");
+    plan.rect.y = r.number(r.member(rect, "floor_plan.rect", "y"), "floor_plan.rect.y");
+    plan.rect.w = r.number(r.member(rect, "floor_plan.rect", "w"), "floor_plan.rect.w");
+    plan.rect.h = r.number(r.member(rect, "floor_plan.rect", "h"), "floor_plan.rect.h");
+    if (fp.contains("m_per_px")) {
+      plan.m_per_px = r.number(fp["m_per_px"], "floor_plan.m_per_px");
+      if (plan.m_per_px <= 0)
+        r.fail("floor_plan.m_per_px",
+               "= " + fmt(plan.m_per_px) + ": must be positive (leave it out for no scale)");
+    }
+    if (fp.contains("scale_points")) {
+      const Json& sp = fp["scale_points"];
+      r.array(sp, "floor_plan.scale_points");
+      if (sp.size() != 2)
+        r.fail("floor_plan.scale_points", "expected 2 points, got " + std::to_string(sp.size()));
+      for (size_t i = 0; i < sp.size(); ++i)
+        plan.scale_points.push_back(
+            r.point(sp[i], "floor_plan.scale_points[" + std::to_string(i) + "]"));
+    }
+    s.floor_plan = std::move(plan);
   }
   validateSketch(s, origin);
   return s;
@@ -244,6 +280,51 @@ void validateSketch(const Sketch& s, const std::string& origin) {
   const double standoff = s.goal_place.standoff_m;
   if (!std::isfinite(standoff) || standoff < 0 || standoff > 3)
     fail("goal_place.standoff_m", "= " + fmt(standoff) + ": must be in [0, 3] m");
+  if (s.floor_plan) {
+    const FloorPlan& fp = *s.floor_plan;
+    // An image the page can show and nothing else: a base64 data URL of a picture type.
+    static const char* kinds[] = {"png", "jpeg", "gif", "webp", "svg+xml"};
+    std::size_t data = std::string::npos;
+    for (const char* k : kinds) {
+      const std::string head = std::string("data:image/") + k + ";base64,";
+      if (fp.image.compare(0, head.size(), head) == 0) data = head.size();
+    }
+    if (data == std::string::npos)
+      fail("floor_plan.image",
+           "must be a data URL data:image/(png|jpeg|gif|webp|svg+xml);base64,...");
+    if (fp.image.size() > kMaxFloorPlanBytes)
+      fail("floor_plan.image", "too large (" + std::to_string(fp.image.size()) + " bytes > " +
+                                   std::to_string(kMaxFloorPlanBytes) + ")");
+    std::size_t pad = 0;
+    for (std::size_t i = data; i < fp.image.size(); ++i) {
+      const unsigned char c = static_cast<unsigned char>(fp.image[i]);
+      const bool b64 = std::isalnum(c) || c == '+' || c == '/';
+      if (c == '=' && ++pad <= 2) continue;
+      if (!b64 || pad > 0) fail("floor_plan.image", "not base64 at byte " + std::to_string(i));
+    }
+    if (fp.image.size() == data || (fp.image.size() - data) % 4 != 0)
+      fail("floor_plan.image", "truncated base64 data");
+    const CanvasRect& r = fp.rect;
+    for (double v : {r.x, r.y, r.w, r.h})
+      if (!std::isfinite(v)) fail("floor_plan.rect", "not a finite number");
+    if (r.w <= 0 || r.h <= 0)
+      fail("floor_plan.rect",
+           "width and height must be positive, got " + fmt(r.w) + " x " + fmt(r.h));
+    if (r.w > 10 * kMaxCanvasPx || r.h > 10 * kMaxCanvasPx || std::abs(r.x) > 10 * kMaxCanvasPx ||
+        std::abs(r.y) > 10 * kMaxCanvasPx)
+      fail("floor_plan.rect", "absurd size or place");
+    if (!std::isfinite(fp.m_per_px) || fp.m_per_px < 0 || fp.m_per_px > 100)
+      fail("floor_plan.m_per_px", "= " + fmt(fp.m_per_px) + ": must be in (0, 100] m per px");
+    if (!fp.scale_points.empty()) {
+      if (fp.scale_points.size() != 2) fail("floor_plan.scale_points", "expected 2 points");
+      for (size_t i = 0; i < 2; ++i) {
+        const std::string f = "floor_plan.scale_points[" + std::to_string(i) + "]";
+        if (!finite(fp.scale_points[i])) fail(f, "not a finite number");
+        if (!inside(fp.scale_points[i]))
+          fail(f, ptxt(fp.scale_points[i]) + " is outside the canvas");
+      }
+    }
+  }
   // A path that passes no landmark gives the robot nothing to look for: almost certainly the
   // path or the landmarks were drawn on the wrong part of the canvas.
   const double near = detail::nearDistancePx(s);
@@ -311,6 +392,19 @@ Json sketchToJson(const Sketch& s) {
   j["start"] = {s.start.x(), s.start.y()};
   j["goal"] = {s.goal.x(), s.goal.y()};
   if (s.goal_place.kind == GoalPlace::Kind::Doorway) j["goal_place"] = goalPlaceJson(s.goal_place);
+  if (s.floor_plan) {
+    const FloorPlan& fp = *s.floor_plan;
+    Json plan = {
+        {"image", fp.image},
+        {"rect", {{"x", fp.rect.x}, {"y", fp.rect.y}, {"w", fp.rect.w}, {"h", fp.rect.h}}}};
+    if (fp.m_per_px > 0) plan["m_per_px"] = fp.m_per_px;
+    if (!fp.scale_points.empty()) {
+      Json pts = Json::array();
+      for (const auto& p : fp.scale_points) pts.push_back({p.x(), p.y()});
+      plan["scale_points"] = pts;
+    }
+    j["floor_plan"] = plan;
+  }
   return j;
 }
 
@@ -335,6 +429,19 @@ std::string sketchToText(const Sketch& s) {
   o << (j["path"].empty() ? "]" : "\n  ]") << ",\n  \"start\": " << j["start"].dump()
     << ",\n  \"goal\": " << j["goal"].dump();
   if (j.contains("goal_place")) o << ",\n  \"goal_place\": " << j["goal_place"].dump();
+  if (j.contains("floor_plan")) {
+    // The image last, on a line of its own (long): the rest of the plan stays readable.
+    Json rest = j["floor_plan"];
+    rest.erase("image");
+    o << ",\n  \"floor_plan\": {";
+    bool first = true;
+    for (const char* k : {"rect", "m_per_px", "scale_points"})
+      if (rest.contains(k)) {
+        o << (first ? "" : ", ") << '"' << k << "\": " << rest[k].dump();
+        first = false;
+      }
+    o << (first ? "" : ",") << "\n    \"image\": " << j["floor_plan"]["image"].dump() << "}";
+  }
   o << "\n}\n";
   return o.str();
 }

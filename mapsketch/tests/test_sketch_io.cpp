@@ -105,6 +105,83 @@ TEST(SketchValidation, ABadGoalPlaceNamesTheField) {
   expectError(j, {"goal_place.kind", "missing"});
 }
 
+// A 1x1 PNG as the editor stores a floor plan: a base64 data URL.
+const char* kPlanPng =
+    "data:image/png;base64,iVBORw0KGgoAAAANSUhEUgAAAAEAAAABCAYAAAAfFcSJAAAADUlEQVR42mP8z8Dw"
+    "HwAFBQIAX8jx0gAAAABJRU5ErkJggg==";
+
+TEST(SketchIo, AFloorPlanRoundTripsWithItsScale) {
+  Sketch a = fixtures::lSketch();
+  EXPECT_FALSE(sketchToJson(a).contains("floor_plan")) << "no plan, no field";
+  FloorPlan fp;
+  fp.image = kPlanPng;
+  fp.rect = {0, 0, a.canvas_width, a.canvas_height};
+  fp.m_per_px = 0.025;
+  fp.scale_points = {{100, 200}, {300, 200}};
+  a.floor_plan = fp;
+  const std::string text = sketchToText(a);
+  EXPECT_NE(text.find("\"floor_plan\": {\"rect\""), std::string::npos)
+      << text.substr(text.size() - 400);
+  const Sketch b = sketchFromText(text);
+  ASSERT_TRUE(b.floor_plan.has_value());
+  EXPECT_EQ(b.floor_plan->image, kPlanPng);
+  EXPECT_DOUBLE_EQ(b.floor_plan->rect.w, a.canvas_width);
+  EXPECT_DOUBLE_EQ(b.floor_plan->m_per_px, 0.025);
+  ASSERT_EQ(b.floor_plan->scale_points.size(), 2u);
+  EXPECT_EQ(b.floor_plan->scale_points[1], Eigen::Vector2d(300, 200));
+  EXPECT_EQ(sketchToJson(b), sketchToJson(a));
+  // The robot's route does not depend on it.
+  EXPECT_EQ(routeToJson(toRoute(b)), routeToJson(toRoute(fixtures::lSketch())));
+  // Without a scale: no m_per_px, no scale_points written.
+  a.floor_plan->m_per_px = 0;
+  a.floor_plan->scale_points.clear();
+  const Json j = sketchToJson(a);
+  EXPECT_FALSE(j["floor_plan"].contains("m_per_px"));
+  EXPECT_FALSE(j["floor_plan"].contains("scale_points"));
+  EXPECT_DOUBLE_EQ(sketchFromJson(j).floor_plan->m_per_px, 0);
+}
+
+TEST(SketchValidation, ABadFloorPlanNamesTheField) {
+  Json j = good();
+  const Json plan = {{"image", kPlanPng},
+                     {"rect", {{"x", 0}, {"y", 0}, {"w", 1000}, {"h", 700}}},
+                     {"m_per_px", 0.02}};
+  j["floor_plan"] = plan;
+  EXPECT_NO_THROW(sketchFromJson(j));
+  j["floor_plan"]["opacity"] = 0.4;
+  expectError(j, {"floor_plan.opacity", "unknown field"});
+  j["floor_plan"] = plan;
+  j["floor_plan"]["image"] = "http://example.invalid/plan.png";
+  expectError(j, {"floor_plan.image", "data URL"});
+  j["floor_plan"]["image"] = "data:text/html;base64,PGI+";
+  expectError(j, {"floor_plan.image", "data URL"});
+  j["floor_plan"]["image"] = "data:image/png;base64,iVBO\"><script>";
+  expectError(j, {"floor_plan.image", "not base64"});
+  j["floor_plan"]["image"] = "data:image/png;base64,iVB";
+  expectError(j, {"floor_plan.image", "truncated"});
+  j["floor_plan"]["image"] =
+      std::string("data:image/png;base64,") + std::string(kMaxFloorPlanBytes, 'A');
+  expectError(j, {"floor_plan.image", "too large"});
+  j["floor_plan"] = plan;
+  j["floor_plan"].erase("image");
+  expectError(j, {"floor_plan.image", "missing"});
+  j["floor_plan"] = plan;
+  j["floor_plan"]["rect"]["w"] = 0;
+  expectError(j, {"floor_plan.rect", "positive"});
+  j["floor_plan"] = plan;
+  j["floor_plan"]["m_per_px"] = -1;
+  expectError(j, {"floor_plan.m_per_px", "positive"});
+  j["floor_plan"]["m_per_px"] = 1e9;
+  expectError(j, {"floor_plan.m_per_px", "(0, 100]"});
+  j["floor_plan"] = plan;
+  j["floor_plan"]["scale_points"] = {{1, 2}};
+  expectError(j, {"floor_plan.scale_points", "2 points"});
+  j["floor_plan"]["scale_points"] = {{1, 2}, {90000, 2}};
+  expectError(j, {"floor_plan.scale_points[1]", "outside the canvas"});
+  j["floor_plan"] = "plan.png";
+  expectError(j, {"floor_plan", "expected an object"});
+}
+
 TEST(SketchIo, PointsAsObjectsAreAccepted) {
   Json j = good();
   j["start"] = {{"x", 100}, {"y", 600}};

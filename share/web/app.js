@@ -103,7 +103,9 @@ function startPoint() { return state.start || (state.path.length ? state.path[0]
 function goalPoint() { return state.goal || (state.path.length ? state.path[state.path.length - 1] : null); }
 
 // ---------- the file format (doc/sketch-format.md) ----------
-function toSketchJson() {
+// withPlan: the floor plan's image too (a data URL of up to MiBs: saved with the file, not sent
+// with every route update).
+function toSketchJson(withPlan = true) {
   return {
     format: 1,
     name: state.name || '',
@@ -117,6 +119,12 @@ function toSketchJson() {
     start: (startPoint() || [0, 0]).map(r1),
     goal: (goalPoint() || [0, 0]).map(r1),
     ...(state.goalDoor === null ? {} : { goal_place: { kind: 'doorway', standoff_m: state.goalDoor } }),
+    ...(withPlan && plan ? { floor_plan: {
+      rect: { x: r1(plan.rect.x), y: r1(plan.rect.y), w: r1(plan.rect.w), h: r1(plan.rect.h) },
+      ...(plan.scale ? { m_per_px: plan.scale } : {}),
+      ...(plan.pts && plan.pts.length === 2 && plan.pts.every(([x, y]) => x >= -0.1 * W && x <= 1.1 * W && y >= -0.1 * H && y <= 1.1 * H) ? { scale_points: plan.pts.map((p) => p.map(r1)) } : {}),
+      image: plan.href,
+    } } : {}),
   };
 }
 
@@ -138,6 +146,8 @@ function fromSketchJson(j) {
   state.startSet = state.goalSet = true;
   const gp = j.goal_place;
   state.goalDoor = gp && gp.kind === 'doorway' ? (gp.standoff_m ?? 0.5) : null;
+  const fp = j.floor_plan;
+  plan = fp ? { href: fp.image, rect: { ...fp.rect }, scale: fp.m_per_px || null, pts: fp.scale_points || null } : null;
   selectedId = null;
 }
 
@@ -363,7 +373,7 @@ async function updateRoute() {
   const seq = ++routeSeq;
   try {
     const res = await fetch('api/route', { method: 'POST', headers: { 'Content-Type': 'application/json' },
-                                           body: JSON.stringify(toSketchJson()) });
+                                           body: JSON.stringify(toSketchJson(false)) });
     const j = await res.json();
     if (seq !== routeSeq) return;  // a newer edit is already being converted
     if (res.ok) { route = j; routeError = ''; adoptReferences(); }
@@ -656,7 +666,7 @@ function renderBackground() {
   lw.replaceChildren();
   const notes = [];
   if (plan) {
-    el('image', { href: plan.href, x: 0, y: 0, width: W, height: H, preserveAspectRatio: 'xMidYMid meet', opacity: 0.4, class: 'plan' }, lp);
+    el('image', { href: plan.href, x: plan.rect.x, y: plan.rect.y, width: plan.rect.w, height: plan.rect.h, preserveAspectRatio: 'xMidYMid meet', opacity: 0.4, class: 'plan' }, lp);
     notes.push(plan.scale ? `floor plan: 1 m = ${(1 / plan.scale).toFixed(1)} px` + (route ? `; your distances: 1 m = ${(1 / route.scale_m_per_px).toFixed(1)} px (${Math.round(Math.abs(plan.scale / route.scale_m_per_px - 1) * 100)} % apart)` : '') : 'floor plan without a scale: Set scale');
     if (plan.pts && plan.pts.length === 2) {
       el('line', { class: 'measure', x1: plan.pts[0][0], y1: plan.pts[0][1], x2: plan.pts[1][0], y2: plan.pts[1][1] }, lp);
@@ -724,11 +734,41 @@ function renderGrid() {
   $('scale-bar-text').textContent = `${step} m (${sc.from})`;
   bar.dataset.stepM = step;
 }
+// The floor plan is saved in the sketch file as a data URL (doc/sketch-format.md, floor_plan;
+// at most 3 MiB): a bigger image is scaled down and stored as JPEG.
+const PLAN_MAX_BYTES = 3 * 1024 * 1024 - 1024;
+function shrinkPlan(dataUrl) {
+  return new Promise((resolve, reject) => {
+    const img = new Image();
+    img.onload = () => {
+      const cv = document.createElement('canvas');
+      for (const [side, q] of [[2400, 0.85], [1800, 0.8], [1200, 0.75], [800, 0.7]]) {
+        const k = Math.min(1, side / Math.max(img.naturalWidth, img.naturalHeight));
+        cv.width = Math.max(1, Math.round(img.naturalWidth * k));
+        cv.height = Math.max(1, Math.round(img.naturalHeight * k));
+        const ctx = cv.getContext('2d');
+        ctx.fillStyle = '#fff';
+        ctx.fillRect(0, 0, cv.width, cv.height);
+        ctx.drawImage(img, 0, 0, cv.width, cv.height);
+        const out = cv.toDataURL('image/jpeg', q);
+        if (out.length <= PLAN_MAX_BYTES) { resolve(out); return; }
+      }
+      reject(new Error('the image is too large even scaled down'));
+    };
+    img.onerror = () => reject(new Error('not an image the browser can read'));
+    img.src = dataUrl;
+  });
+}
 function loadPlan(file) {
   if (!file) return;
   const r = new FileReader();
-  r.onload = () => {
-    plan = { href: r.result, scale: null, pts: null };
+  r.onload = async () => {
+    let href = r.result;
+    if (!/^data:image\/(png|jpeg|gif|webp|svg\+xml);base64,/.test(href) || href.length > PLAN_MAX_BYTES) {
+      try { href = await shrinkPlan(href); } catch (e) { setStatus('Floor plan not loaded: ' + e.message, 'error'); return; }
+    }
+    plan = { href, rect: { x: 0, y: 0, w: W, h: H }, scale: null, pts: null };
+    dirty = true;
     render();
     setTool('measure');
   };
@@ -748,6 +788,7 @@ function measureClick(p) {
   if (!(m > 0) || px < 5) { setStatus('Scale not set (give a distance > 0 between two distinct points).', 'error'); setTool('select'); return; }
   plan.scale = m / px;
   plan.pts = [a, b];
+  dirty = true;
   setTool('select');
   render();
   setStatus(`Floor plan scale: ${m} m over ${px.toFixed(0)} px, 1 m = ${(px / m).toFixed(1)} px.`, 'ok');
@@ -914,7 +955,7 @@ function init() {
   $('show-grid').addEventListener('change', renderGrid);
   $('plan-file').addEventListener('change', (e) => { loadPlan(e.target.files[0]); e.target.value = ''; });
   $('plan-scale').addEventListener('click', () => setTool('measure'));
-  $('plan-clear').addEventListener('click', () => { plan = null; render(); });
+  $('plan-clear').addEventListener('click', () => { plan = null; dirty = true; render(); });
   $('run-sketch').addEventListener('click', runThisSketch);
   new ResizeObserver(() => renderGrid()).observe(svg);
   $('delete').addEventListener('click', deleteSelected);

@@ -395,6 +395,7 @@ function drawGeometry(g, traj) {
   for (const k of ['floor', 'sketch_path']) for (const p of g[k] || []) pts.push(p);
   for (const w of g.walls || []) pts.push(w.slice(0, 2), w.slice(2, 4));
   for (const p of traj) pts.push(p);
+  for (const l of g.sketch_landmarks || []) pts.push([l.x, l.y]);
   pts.push([0, 0]);
   const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
   const x0 = Math.min(...xs) - 1, x1 = Math.max(...xs) + 1, y0 = Math.min(...ys) - 1, y1 = Math.max(...ys) + 1;
@@ -418,6 +419,7 @@ function drawGeometry(g, traj) {
     const t = el('text', { class: 'sketch-lm-label', x: l.x + unit * 1.5, y: -l.y - unit * 1.2, 'font-size': unit * 3 }, base);
     t.textContent = l.id + '?';
   }
+  el('g', { id: 'map-placed' }, svg);  // the route as the robot places it now (drawPlacement)
   el('polyline', { id: 'map-traj', class: 'traj', points: '', 'vector-effect': 'non-scaling-stroke' }, svg);
   el('polygon', { id: 'map-robot', class: 'robot', points: '', 'vector-effect': 'non-scaling-stroke' }, svg);
 }
@@ -430,6 +432,7 @@ async function pollMap() {
       geometryKey = key;
       drawGeometry(m.geometry || {}, m.trajectory);
     }
+    drawPlacement(m.placement);
     $('map-traj').setAttribute('points', m.trajectory.map(P).join(' '));
     const robot = $('map-robot');
     if (m.pose) {
@@ -442,6 +445,38 @@ async function pollMap() {
     }
     drawGhost();
   } catch (_) { /* the state poll reports a lost server */ }
+}
+
+// The sketch as the executive places it now: refitted to the landmark fixes so far (solid
+// teal: path, landmarks where it now expects them, goal). Drawn once it differs from the
+// sketched placement (the first refit); the note under the map says by how much.
+let placementKey = '';
+function drawPlacement(pl) {
+  const g = $('map-placed');
+  const note = $('placement-note');
+  const key = pl ? `${pl.refits}|${pl.t}` : '';
+  if (!g || (key === placementKey && g.dataset.drawn === key)) return;
+  placementKey = key;
+  g.dataset.drawn = key;
+  g.replaceChildren();
+  if (!pl || !pl.refits) {
+    if (note) note.textContent = pl ? 'Refitted sketch: not refitted yet (no landmark fix).' : '';
+    return;
+  }
+  const unit = Number($('map').dataset.unit);
+  const pts = pl.path && pl.path.length ? pl.path : pl.guide_points || [];
+  el('polyline', { id: 'map-placed-path', class: 'placed-path', points: pts.map(P).join(' '), 'vector-effect': 'non-scaling-stroke' }, g);
+  for (const l of pl.landmarks || []) {
+    el('circle', { class: 'placed-lm', cx: l.x, cy: -l.y, r: unit * 0.7, 'vector-effect': 'non-scaling-stroke' }, g)
+      .append(Object.assign(document.createElementNS(SVGNS, 'title'), { textContent: `${l.id}: where the refitted sketch puts it` }));
+  }
+  if (pl.goal) el('circle', { class: 'placed-goal', cx: pl.goal[0], cy: -pl.goal[1], r: unit * 1.0, 'vector-effect': 'non-scaling-stroke' }, g);
+  if (note) {
+    const st = pl.start || [0, 0];
+    note.textContent = `Refitted sketch (${pl.refits} refit${pl.refits === 1 ? '' : 's'}, last at t = ${pl.t.toFixed(1)} s): ` +
+      `rotated ${pl.rotation_deg >= 0 ? '+' : ''}${pl.rotation_deg.toFixed(1)}°, scale ×${pl.scale.toFixed(3)}, ` +
+      `start shifted ${Math.hypot(st[0], st[1]).toFixed(2)} m.`;
+  }
 }
 
 // The robot where it was at the scrubbed time (hollow), while scrubbing back.

@@ -212,6 +212,79 @@ try {
     await page.selectOption('#world', 'corridor');
   });
 
+  await check('3: a floor plan loaded in the editor is saved with the sketch: reopened after a reload, it is there at the same scale', async () => {
+    await openEditor();
+    await openExample('lab');
+    await page.selectOption('#world', '');
+    await page.setInputFiles('#plan-file', planPng);
+    await page.waitForSelector('#layer-plan image.plan');
+    promptAnswer = '4';
+    for (const p of [[200, 350], [600, 350]]) { const sc = await toScreen(...p); await page.mouse.click(sc[0], sc[1]); }
+    await page.waitForFunction(() => plan && plan.scale);
+    const before = await page.evaluate(() => ({ scale: plan.scale, rect: plan.rect, href: plan.href, note: document.getElementById('bg-note').textContent, bar: document.getElementById('scale-bar-text').textContent }));
+    assert.ok(Math.abs(before.scale - 4 / 400) < 1e-9, `scale ${before.scale} m/px`);
+    await page.fill('#name', 'with-plan');
+    await page.click('#save');
+    await page.waitForFunction(() => /Saved/.test(document.getElementById('status').textContent));
+    // The file keeps the plan (image, where it is drawn, its scale and the measured points).
+    const file = JSON.parse(fs.readFileSync(path.join(sketchDir, 'with-plan.sketch.json'), 'utf8'));
+    assert.ok(file.floor_plan, 'floor_plan in the file');
+    assert.equal(file.floor_plan.m_per_px, before.scale);
+    assert.deepEqual(file.floor_plan.rect, before.rect);
+    assert.deepEqual(file.floor_plan.scale_points, [[200, 350], [600, 350]]);
+    assert.equal(file.floor_plan.image, before.href, 'the image as loaded');
+    // The route the robot follows is the same with or without it.
+    const noPlan = JSON.parse(execFileSync(sketchnav, ['--json', 'route', path.join(sketchDir, 'with-plan.sketch.json')]).toString());
+    assert.ok(noPlan.sections.length > 0, 'sketchnav route reads the file');
+    // A reload forgets the page; opening the sketch brings the plan back at the same scale.
+    await page.reload();
+    await page.waitForSelector('.class-card[data-class="Oatly-Oat-Milk"]');
+    assert.equal(await page.locator('#layer-plan image.plan').count(), 0, 'no plan after the reload');
+    await page.waitForSelector('#open option[value="sketches/with-plan.sketch.json"]', { state: 'attached' });
+    await page.selectOption('#open', 'sketches/with-plan.sketch.json');
+    await page.waitForSelector('#layer-plan image.plan');
+    await page.waitForFunction(() => route !== null);
+    const after = await page.evaluate(() => ({ scale: plan.scale, rect: plan.rect, href: plan.href, note: document.getElementById('bg-note').textContent, bar: document.getElementById('scale-bar-text').textContent,
+      img: (() => { const i = document.querySelector('#layer-plan image.plan'); return ['x', 'y', 'width', 'height'].map((k) => +i.getAttribute(k)); })() }));
+    assert.equal(after.scale, before.scale, 'same scale');
+    assert.deepEqual(after.rect, before.rect, 'same place');
+    assert.deepEqual(after.img, [before.rect.x, before.rect.y, before.rect.w, before.rect.h]);
+    assert.equal(after.href, before.href, 'same image');
+    assert.match(after.note, /floor plan: 1 m = 100\.0 px/);
+    assert.match(after.bar, /m \(floor plan\)$/);
+    assert.equal(await page.isDisabled('#plan-clear'), false);
+    await shot(page, 'editor-plan-reopened');
+    // Removing the plan and saving again leaves no floor_plan in the file.
+    await page.click('#plan-clear');
+    await page.click('#save');
+    await page.waitForFunction(() => /Saved/.test(document.getElementById('status').textContent));
+    assert.equal(JSON.parse(fs.readFileSync(path.join(sketchDir, 'with-plan.sketch.json'), 'utf8')).floor_plan, undefined);
+    await page.selectOption('#world', 'corridor');
+  });
+
+  await check('8: the editor toolbar fits on one line at 1280x800', async () => {
+    await page.setViewportSize({ width: 1280, height: 800 });
+    await openEditor();
+    await openExample('lab');
+    const m = await page.evaluate(() => {
+      const bar = document.getElementById('toolbar');
+      const kids = [...bar.querySelectorAll('button, label')].filter((e) => e.getBoundingClientRect().width > 0);
+      // Lines: items whose vertical centres lie within half a button's height of each other.
+      const mids = kids.map((e) => { const r = e.getBoundingClientRect(); return (r.top + r.bottom) / 2; }).sort((a, b) => a - b);
+      const half = document.getElementById('undo').getBoundingClientRect().height / 2;
+      const tops = mids.filter((m, i) => i === 0 || m - mids[i - 1] > half);
+      const b = bar.getBoundingClientRect();
+      const btn = document.getElementById('undo').getBoundingClientRect();
+      const stage = document.getElementById('stage').getBoundingClientRect();
+      const rights = kids.map((e) => e.getBoundingClientRect().right);
+      return { h: b.height, btn: btn.height, lines: tops.length, widths: kids.map((e) => Math.round(e.getBoundingClientRect().width)), barW: b.width, right: Math.max(...rights), stageRight: stage.right, items: kids.length };
+    });
+    assert.equal(m.lines, 1, `toolbar items on ${m.lines} lines (widths ${m.widths}, toolbar ${m.barW} px)`);
+    assert.ok(m.h < 1.6 * m.btn, `toolbar ${m.h} px high, one button is ${m.btn} px`);
+    assert.ok(m.right <= m.stageRight + 0.5, `nothing sticks out (${m.right} > ${m.stageRight})`);
+    await shot(page, 'editor-1280', { clip: { x: 0, y: 0, width: 1280, height: 200 } });
+  });
+
   // ---- 5: the distance model ------------------------------------------------------------
   await check('5: each distance says what it counts from; reordering the route warns that a distance now counts from another landmark', async () => {
     await openEditor();
@@ -337,7 +410,7 @@ try {
     await page.selectOption('#opt-detections', '1');
     await page.waitForFunction(() => /detections=1/.test(document.getElementById('camera-img').src));
     const legend = await page.$$eval('#map-legend li', (ls) => ls.filter((l) => l.getBoundingClientRect().height > 0).map((l) => l.textContent));
-    assert.deepEqual(legend, ['wall', 'obstacle', 'landmark (real)', 'landmark (sketched)', 'sketched path', 'trajectory (odometry)', 'robot', 'goal']);
+    assert.deepEqual(legend, ['wall', 'obstacle', 'landmark (real)', 'landmark (sketched)', 'sketched path', 'sketch as refitted', 'trajectory (odometry)', 'robot', 'goal']);
     await page.selectOption('#opt-windows', '20');
     await page.selectOption('#opt-detections', '-1');
     void s;

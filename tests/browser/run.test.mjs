@@ -1,8 +1,10 @@
 // Browser test of the live run page (`sketchnav ui`, run.html): starts a simulated run of the
 // corridor world from the page, waits for the camera, the command and the pose to move,
 // captures a frame and a dragged box into a landmark class folder, presses STOP and checks
-// that the base was commanded to stop and the run ended "stopped by user". Leaves
-// screenshots (run-live.png, run-stopped.png) in --out for a person to look at.
+// that the base was commanded to stop and the run ended "stopped by user". Then a short lab
+// run: after its first landmark is passed, the map draws the sketch as the robot refitted it,
+// apart from the sketched path. Leaves screenshots (run-live.png, run-refit.png, run-stopped.png) in
+// --out for a person to look at.
 // Debian's chromium, driven by playwright-core; exits 77 (skipped) when either is missing.
 import { spawn } from 'node:child_process';
 import assert from 'node:assert/strict';
@@ -130,6 +132,7 @@ try {
 
   await page.screenshot({ path: path.join(out, 'run-live.png') });
 
+
   // 5. STOP: the base is commanded to stop and the run ends "stopped by user".
   await page.click('#stop');
   await page.waitForFunction(() => document.getElementById('status-badge').textContent === 'stopped', null, { timeout: 15000 });
@@ -156,8 +159,41 @@ try {
   assert.deepEqual(pageErrors, [], 'no errors on the page');
 
   await page.screenshot({ path: path.join(out, 'run-stopped.png') });
-  console.log('screenshots:', path.join(out, 'run-live.png'), path.join(out, 'run-stopped.png'));
-  console.log('PASS: run page starts a simulated run, shows it live, captures, and STOP stops the base');
+  // 6. The sketch as the robot refits it: a short lab run (its first landmark is passed a few
+  // seconds in; the corridor's first is often missed). The fix refits the route -> odometry
+  // alignment and the map draws the refitted route, apart from the sketched one.
+  await page.selectOption('#world', 'lab');
+  await page.fill('#seed', '1');
+  await page.fill('#max-time', '25');
+  await page.click('#start');
+  await page.waitForFunction(() => document.getElementById('status-badge').textContent === 'running', null, { timeout: 150000 });
+  const mapApi = () => page.evaluate(async () => (await fetch('/api/run/map')).json());
+  assert.equal(await page.locator('#map-legend .lg.placed-path').count(), 1, 'legend entry for the refitted sketch');
+  await waitState((s) => s.t > 0, 'the lab run to tick', 20000);
+  const m0 = await mapApi();
+  assert.ok(m0.placement && m0.placement.path.length > 1, 'placement reported from the start: ' + JSON.stringify(m0.placement).slice(0, 200));
+  const sPass = await waitState((s) => s.events.some((e) => e.type === 'landmark_passed'), 'a landmark to be passed', 90000);
+  const passed = sPass.events.find((e) => e.type === 'landmark_passed');
+  console.log('passed', passed.id, 'reanchor_m', passed.reanchor_m, 'fit_scale', passed.fit_scale);
+  await page.waitForSelector('#map-placed-path', { state: 'attached', timeout: 5000 });
+  const m1 = await mapApi();
+  assert.ok(m1.placement.refits >= 1, `refitted (${m1.placement.refits})`);
+  const parsePts = (str) => str.trim().split(/\s+/).map((p) => p.split(',').map(Number));
+  const drawn = parsePts(await page.getAttribute('#map polyline.sketch-path', 'points'));
+  const placed = parsePts(await page.getAttribute('#map-placed-path', 'points'));
+  assert.equal(placed.length, drawn.length, 'the same drawn path, placed anew');
+  const moved = Math.max(...placed.map((p, i) => Math.hypot(p[0] - drawn[i][0], p[1] - drawn[i][1])));
+  assert.ok(moved > 0.03, `the refitted route differs from the sketched one (max ${moved.toFixed(3)} m)`);
+  assert.ok(moved < 5, `...but stays near it (max ${moved.toFixed(3)} m)`);
+  assert.match(await page.textContent('#placement-note'), /Refitted sketch \(\d+ refits?/);
+  assert.ok(await page.locator('#map-placed circle.placed-lm').count() >= 1, 'landmarks where the refit puts them');
+  console.log(`refitted route: ${m1.placement.refits} refit(s), moved up to ${moved.toFixed(2)} m;`, await page.textContent('#placement-note'));
+  await page.locator('#info-panel').screenshot({ path: path.join(out, 'run-refit.png') });
+  await page.click('#stop');
+  await page.waitForFunction(() => document.getElementById('status-badge').textContent === 'stopped', null, { timeout: 15000 });
+  assert.deepEqual(pageErrors, [], 'no errors on the page');
+  console.log('screenshots:', ['run-live.png', 'run-stopped.png', 'run-refit.png'].map((f) => path.join(out, f)).join(' '));
+  console.log('PASS: run page starts a simulated run, shows it live, captures, and STOP stops the base; the map draws the sketch as refitted at a landmark');
 } catch (e) {
   failed = true;
   console.error('FAIL:', String(e.message).split('\n').slice(0, 8).join('\n'));

@@ -84,6 +84,14 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
     auto camera = h.wrap_camera(std::make_unique<FakeCamera>());
     auto base = h.wrap_base(std::make_unique<FakeBase>(log));
     h.on_event({0.0, nav::event::Start{3, 5.0}});
+    // The route as refitted at a landmark fix (cmd_ui's PlacementReporter reports this).
+    if (h.on_placement)
+      h.on_placement({{"path", {{0, 0.2}, {3, 0.2}, {3, 2.2}}},
+                      {"refits", 1},
+                      {"scale", 1.0},
+                      {"rotation_deg", 0.0},
+                      {"start", {0, 0.2}},
+                      {"t", 0.0}});
     std::string reason = "arrived";
     bool success = true;
     for (int i = 0; i < max_ticks; ++i) {
@@ -242,6 +250,10 @@ TEST_F(UiRunHttp, StartShowsProgressAndStopStopsTheBase) {
   EXPECT_EQ(m["geometry"]["frame"], "odometry");
   EXPECT_GE(m["trajectory"].size(), 3u);
   EXPECT_TRUE(m["pose"].is_object());
+  // The refitted route, as the runner reported it, beside the sketched one.
+  ASSERT_TRUE(m["placement"].is_object()) << m.dump();
+  EXPECT_EQ(m["placement"]["refits"], 1);
+  EXPECT_EQ(m["placement"]["path"][1][1], 0.2);
 
   EXPECT_TRUE(log_->moving.load());
   auto st = post("/api/run/stop", Json::object());

@@ -19,6 +19,8 @@ constexpr std::size_t kMaxPathPoints = 20000;  // a mouse path of ~60 canvas wid
 constexpr std::size_t kMaxLandmarks = 200;
 constexpr double kMaxDistanceM = 1000;  // a "distance" above this is a typo (mm? feet?)
 constexpr double kMaxCanvasPx = 20000;
+// The floor plan's data URL (Sketch::floor_plan): 3 MiB, so that the sketch fits its limit.
+constexpr std::size_t kMaxFloorPlanBytes = 3u << 20;
 
 /// Parses and structurally validates a sketch from JSON: types, NaN/inf, ranges, duplicate
 /// ids, path length, the path coming near a landmark. `origin` (a file name) prefixes every

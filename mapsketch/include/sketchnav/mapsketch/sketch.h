@@ -4,6 +4,7 @@
 // turns it into what the robot follows.
 #include <Eigen/Core>
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -31,6 +32,15 @@ struct GoalPlace {
   double standoff_m = 0.5;  // [m] doorway: stop this far in front of the opening (0 = in it)
 };
 
+/// A floor-plan image the sketch was traced over (the editor's *Floor plan…*), kept with the
+/// sketch for people; the robot never uses it. doc/sketch-format.md, "floor_plan".
+struct FloorPlan {
+  std::string image;    // a data URL: data:image/(png|jpeg|gif|webp|svg+xml);base64,...
+  CanvasRect rect;      // [canvas px] where the image is drawn (fitted inside, aspect kept)
+  double m_per_px = 0;  // [m per canvas px] the scale the user set on it; 0 = none
+  std::vector<Eigen::Vector2d> scale_points;  // the two points it was measured between, or none
+};
+
 struct Sketch {
   int format = 1;
   double canvas_width = 1000, canvas_height = 700;  // [canvas px]
@@ -41,6 +51,7 @@ struct Sketch {
   GoalPlace goal_place;               // optional in the file ("goal_place")
   std::string name;                   // free text
   std::string notes;                  // free text for people (e.g. how it was drawn); optional
+  std::optional<FloorPlan> floor_plan;  // optional in the file ("floor_plan")
 };
 
 }  // namespace sketchnav::mapsketch
