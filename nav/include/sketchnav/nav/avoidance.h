@@ -50,7 +50,8 @@ struct AvoidParams {
   double reverse_speed = 0.12;       // [m/s] back-off speed when something keeps coming closer
   // In the executive: the approach estimate counts only points on floor the occupancy grid
   // had seen free 1.5-3 s before (ObstacleAvoider::setMovedInTest); false = every point.
-  bool approach_needs_free_floor = true;
+  // Off by default: doc/navigation.md "Evidence for the defaults".
+  bool approach_needs_free_floor = false;
   // Someone walking towards the robot is followed from scan to scan (a person-sized group of
   // laser points, with its velocity) for as long as it is in view, not only while it closes
   // the corridor ahead. While its lane (its straight path over lane_horizon_s, as wide as
