@@ -116,6 +116,24 @@ Json RunRequest::toJson() const {
   return j;
 }
 
+CaptureRequest CaptureRequest::fromJson(const Json& j) {
+  if (!j.contains("class") || !j["class"].is_string())
+    throw InputError("capture: 'class' (a landmark class name) is required");
+  std::optional<cv::Rect> box;
+  if (j.contains("box") && !j["box"].is_null()) {
+    const Json& b = j["box"];
+    if (!b.is_array() || b.size() != 4)
+      throw InputError("capture: 'box' must be [x, y, width, height] in frame pixels");
+    for (const auto& v : b)
+      if (!v.is_number()) throw InputError("capture: 'box' values must be numbers");
+    box = cv::Rect(static_cast<int>(std::lround(b[0].get<double>())),
+                   static_cast<int>(std::lround(b[1].get<double>())),
+                   static_cast<int>(std::lround(b[2].get<double>())),
+                   static_cast<int>(std::lround(b[3].get<double>())));
+  }
+  return {j["class"].get<std::string>(), box};
+}
+
 std::string safeClassName(const std::string& name) {
   static const std::regex ok(R"([A-Za-z0-9_][A-Za-z0-9_. -]{0,79})");
   if (!std::regex_match(name, ok) || name.find("..") != std::string::npos || name.back() == ' ' ||
@@ -927,22 +945,8 @@ void addRunRoutes(Server& server, RunController& rc) {
     sendJson(res, {{"worlds", o.worlds}, {"sketches", list}, {"sketch_files", detailed}});
   });
   server.post("/api/capture", [&rc](const httplib::Request& req, httplib::Response& res) {
-    const Json j = parseJsonBody(req, "capture");
-    if (!j.contains("class") || !j["class"].is_string())
-      throw InputError("capture: 'class' (a landmark class name) is required");
-    std::optional<cv::Rect> box;
-    if (j.contains("box") && !j["box"].is_null()) {
-      const Json& b = j["box"];
-      if (!b.is_array() || b.size() != 4)
-        throw InputError("capture: 'box' must be [x, y, width, height] in frame pixels");
-      for (const auto& v : b)
-        if (!v.is_number()) throw InputError("capture: 'box' values must be numbers");
-      box = cv::Rect(static_cast<int>(std::lround(b[0].get<double>())),
-                     static_cast<int>(std::lround(b[1].get<double>())),
-                     static_cast<int>(std::lround(b[2].get<double>())),
-                     static_cast<int>(std::lround(b[3].get<double>())));
-    }
-    sendJson(res, rc.capture(j["class"].get<std::string>(), box));
+    const CaptureRequest c = CaptureRequest::fromJson(parseJsonBody(req, "capture"));
+    sendJson(res, rc.capture(c.class_name, c.box));
   });
 }
 

@@ -61,6 +61,14 @@ struct RunRequest {
   Json toJson() const;
 };
 
+/// What POST /api/capture asks for: {class, box?: [x, y, w, h]}.
+struct CaptureRequest {
+  std::string class_name;
+  std::optional<cv::Rect> box;
+  /// From the POST body; InputError naming the bad field.
+  static CaptureRequest fromJson(const Json& j);
+};
+
 /// How a runner reports to the page. All are set by RunController and called on the run's
 /// thread.
 struct RunHooks {
