@@ -1,10 +1,12 @@
 #include "entry_points.h"
 
-// run_api.h first: it includes the Eigen-using headers before httplib.h (see there).
-#include "run_api.h"
+// Eigen (through sketch.h) before httplib.h (server.h): a macro of httplib's breaks Eigen.
+#include "sketchnav/mapsketch/sketch.h"
+// clang-format off
+#include "run_request.h"
 #include "server.h"
 #include "sketchnav/core/error.h"
-#include "sketchnav/mapsketch/sketch.h"
+// clang-format on
 
 namespace sketchnav::fuzz {
 
