@@ -1,5 +1,7 @@
 #include "entry_points.h"
 
+#include <cmath>
+
 // Eigen (through sketch.h) before httplib.h (server.h): a macro of httplib's breaks Eigen.
 #include "sketchnav/mapsketch/sketch.h"
 // clang-format off
@@ -20,11 +22,19 @@ void webui(const std::uint8_t* d, std::size_t n) {
     const Json j = ui::parseJsonBody(req, "run request");
     refusedIsFine([&] {
       const ui::RunRequest r = ui::RunRequest::fromJson(j);
-      // What the page gets back must be accepted again.
+      // An accepted seed is the number sent (not wrapped into int); what the page gets back
+      // must be accepted again.
+      if (j.contains("seed") && Json(r.seed) != j["seed"]) __builtin_trap();
       (void)ui::RunRequest::fromJson(r.toJson());
     });
     refusedIsFine([&] {
       const ui::CaptureRequest c = ui::CaptureRequest::fromJson(j);
+      // An accepted box is the numbers sent, rounded to pixels.
+      if (c.box) {
+        const int got[4] = {c.box->x, c.box->y, c.box->width, c.box->height};
+        for (int i = 0; i < 4; ++i)
+          if (!(std::abs(got[i] - j["box"][i].get<double>()) <= 0.5)) __builtin_trap();
+      }
       (void)ui::safeClassName(c.class_name);
     });
   });

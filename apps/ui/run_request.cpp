@@ -2,7 +2,9 @@
 // the navigation stack (the fuzzer, fuzz/entry_webui.cpp, links only these).
 #include "run_request.h"
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <regex>
 
 #include "sketchnav/core/error.h"
@@ -28,9 +30,14 @@ RunRequest RunRequest::fromJson(const Json& j) {
   str("laser", r.laser);
   str("sonar", r.sonar);
   if (j.contains("seed")) {
-    if (!j["seed"].is_number_integer() || j["seed"].get<int>() < 0)
-      throw InputError("run request: 'seed' must be an integer >= 0");
-    r.seed = j["seed"].get<int>();
+    // Range-checked as a 64-bit value: get<int>() would wrap 4294967297 to seed 1.
+    const Json& v = j["seed"];
+    const bool ok = v.is_number_unsigned()  ? v.get<std::uint64_t>() <= INT_MAX
+                    : v.is_number_integer() ? v.get<std::int64_t>() >= 0 &&
+                                                  v.get<std::int64_t>() <= INT_MAX
+                                            : false;
+    if (!ok) throw InputError("run request: 'seed' must be an integer 0..2147483647");
+    r.seed = v.get<int>();
   }
   if (j.contains("max_time_s")) {
     if (!j["max_time_s"].is_number() || !(j["max_time_s"].get<double>() >= 0))
@@ -94,8 +101,10 @@ CaptureRequest CaptureRequest::fromJson(const Json& j) {
     const Json& b = j["box"];
     if (!b.is_array() || b.size() != 4)
       throw InputError("capture: 'box' must be [x, y, width, height] in frame pixels");
+    // Bounded before lround() / int: 1e300 would come back as an unspecified pixel.
     for (const auto& v : b)
-      if (!v.is_number()) throw InputError("capture: 'box' values must be numbers");
+      if (!v.is_number() || !(std::abs(v.get<double>()) <= 1e6))
+        throw InputError("capture: 'box' values must be numbers of pixels (|v| <= 1000000)");
     box = cv::Rect(static_cast<int>(std::lround(b[0].get<double>())),
                    static_cast<int>(std::lround(b[1].get<double>())),
                    static_cast<int>(std::lround(b[2].get<double>())),
