@@ -2,7 +2,9 @@
 // rejects unknown keys (typos would otherwise silently fall back to defaults).
 #include "sketchnav/sim/world.h"
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -57,6 +59,12 @@ class Reader {
     if (!v) return def;
     if (!v->is_number_integer())
       fail(key, "must be an integer (got " + clipForMessage(v->dump()) + ")");
+    // Range-checked as 64 bits first: get<int>() would wrap 4294967297 to 1.
+    const bool fits = v->is_number_unsigned()
+                          ? v->get<std::uint64_t>() <= static_cast<std::uint64_t>(INT_MAX)
+                          : v->get<std::int64_t>() >= INT_MIN && v->get<std::int64_t>() <= INT_MAX;
+    if (!fits)
+      fail(key, "must be an integer within ±2147483647 (got " + clipForMessage(v->dump()) + ")");
     return v->get<int>();
   }
   bool boolean(const std::string& key, bool def) {
@@ -107,8 +115,11 @@ class Reader {
     int rgb[3];
     for (int i = 0; i < 3; ++i) {
       if (!(*v)[i].is_number()) fail(key, "must be [r, g, b] with values 0..255");
-      rgb[i] = (*v)[i].get<int>();
-      if (rgb[i] < 0 || rgb[i] > 255) fail(key, "must be [r, g, b] with values 0..255");
+      // Checked as a double before the conversion: get<int>() of 1.8e105 is undefined (UBSan,
+      // fuzz_world). Fractions truncate as before.
+      const double x = (*v)[i].get<double>();
+      if (!(x >= 0 && x < 256)) fail(key, "must be [r, g, b] with values 0..255");
+      rgb[i] = static_cast<int>(x);
     }
     return cv::Scalar(rgb[2], rgb[1], rgb[0]);
   }
