@@ -153,13 +153,20 @@ void eachItem(Reader& r, const std::string& key, F&& f) {
 
 std::string resolveTexture(const std::string& rel, const std::string& base_dir) {
   if (rel.empty()) return {};
+  // error_code overloads: a name the OS refuses (too long: fuzz_world) is "not found" (an
+  // InputError naming the field at the caller), not a filesystem_error escaping the parser.
+  std::error_code ec;
+  const auto found = [&ec](const fs::path& f) -> std::string {
+    if (!fs::exists(f, ec) || ec) return {};
+    const fs::path c = fs::canonical(f, ec);
+    return ec ? std::string() : c.string();
+  };
   const fs::path p(rel);
-  if (p.is_absolute()) return fs::exists(p) ? p.string() : std::string();
-  if (!base_dir.empty() && fs::exists(fs::path(base_dir) / p))
-    return fs::canonical(fs::path(base_dir) / p).string();
+  if (p.is_absolute()) return fs::exists(p, ec) && !ec ? p.string() : std::string();
+  if (!base_dir.empty())
+    if (std::string r = found(fs::path(base_dir) / p); !r.empty()) return r;
   try {
-    const fs::path s = fs::path(resourceDir()) / p;
-    if (fs::exists(s)) return fs::canonical(s).string();
+    return found(fs::path(resourceDir()) / p);
   } catch (const RuntimeError&) {
   }
   return {};
