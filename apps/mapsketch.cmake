@@ -5,7 +5,8 @@
 pkg_check_modules(CPPHTTPLIB REQUIRED IMPORTED_TARGET cpp-httplib)
 # run_api.cpp is the live run page (state, frames, stop, capture); the run itself is handed in
 # by the command (cmd_ui.cpp), so the library needs only the nav/hw types, not the simulator.
-add_library(sketchnav_webui STATIC ui/server.cpp ui/editor_api.cpp ui/run_api.cpp)
+add_library(sketchnav_webui STATIC ui/server.cpp ui/editor_api.cpp ui/run_api.cpp
+            ui/run_request.cpp)
 add_library(sketchnav::webui ALIAS sketchnav_webui)
 target_include_directories(sketchnav_webui PUBLIC ${CMAKE_CURRENT_SOURCE_DIR}/ui)
 target_link_libraries(sketchnav_webui PUBLIC sketchnav::core sketchnav::mapsketch sketchnav::hw

@@ -5,6 +5,7 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <cstdio>
 #include <filesystem>
@@ -429,7 +430,9 @@ std::map<std::string, std::string> readTruthCsv(const std::string& path) {
     if (t.empty() && n == 1 && fr == "frame" && e == "expected") continue;  // header
     if (fr.empty()) fail("empty frame");
     std::string l = e;
-    std::transform(l.begin(), l.end(), l.begin(), ::tolower);
+    // Through unsigned char: ::tolower of a negative char (a UTF-8 byte) is undefined.
+    std::transform(l.begin(), l.end(), l.begin(),
+                   [](unsigned char ch) { return static_cast<char>(std::tolower(ch)); });
     std::string turn;
     if (l == "l" || l == "left") turn = "Left";
     if (l == "s" || l == "straight") turn = "Straight";

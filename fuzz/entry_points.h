@@ -32,9 +32,16 @@ void config(const std::uint8_t* data, std::size_t size);
 void model(const std::uint8_t* data, std::size_t size);
 void baseProtocol(const std::uint8_t* data, std::size_t size);
 void image(const std::uint8_t* data, std::size_t size);
+void voc(const std::uint8_t* data, std::size_t size);
+void truth(const std::uint8_t* data, std::size_t size);
+void webui(const std::uint8_t* data, std::size_t size);
+void rawlog(const std::uint8_t* data, std::size_t size);
+/// Re-sealed (entry_sealed.cpp): length and checksum fixed up, then the plain entry point.
+void baseProtocolSealed(const std::uint8_t* data, std::size_t size);
+void modelSealed(const std::uint8_t* data, std::size_t size);
 
-/// The entry point named "sketch", "world", "config", "model", "protocol" or "image"; nullptr
-/// if none.
+/// The entry point named "sketch", "world", "config", "model", "protocol", "image", "voc",
+/// "truth", "webui", "rawlog", "protocol_sealed" or "model_sealed"; nullptr if none.
 using EntryPoint = void (*)(const std::uint8_t*, std::size_t);
 EntryPoint byName(const std::string& name);
 

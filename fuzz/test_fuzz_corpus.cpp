@@ -75,4 +75,28 @@ TEST(FuzzCorpus, ImageRegressionsAndSeeds) {
 TEST(FuzzCorpus, ModelAndProtocolRegressions) {
   replay("model", filesIn(kSource / "fuzz/regressions/model"));
   replay("protocol", filesIn(kSource / "fuzz/regressions/protocol"));
+  // The same files re-sealed (fuzz_*_sealed), and what those harnesses found.
+  replay("model_sealed", filesIn(kSource / "fuzz/regressions/model"));
+  replay("protocol_sealed", filesIn(kSource / "fuzz/regressions/protocol"));
+  replay("model_sealed", filesIn(kSource / "fuzz/regressions/model_sealed"));
+  replay("protocol_sealed", filesIn(kSource / "fuzz/regressions/protocol_sealed"));
+}
+
+TEST(FuzzCorpus, VocRegressionsAndSeeds) {
+  sketchnav::log::setQuiet(true);
+  EXPECT_GT(replay("voc", filesIn(kSource / "fuzz/regressions/voc")), 0);
+}
+
+TEST(FuzzCorpus, TruthRegressionsAndSeeds) {
+  EXPECT_GT(replay("truth", filesIn(kSource / "fuzz/regressions/truth")), 0);
+}
+
+TEST(FuzzCorpus, WebUiRegressionsAndSeeds) {
+  EXPECT_GT(replay("webui", filesIn(kSource / "fuzz/regressions/webui")), 0);
+  EXPECT_GT(replay("webui", filesIn(kSource / "share/sketches", ".json")), 0);
+}
+
+TEST(FuzzCorpus, RawlogRegressionsAndSeeds) {
+  sketchnav::log::setQuiet(true);
+  EXPECT_GT(replay("rawlog", filesIn(kSource / "fuzz/regressions/rawlog")), 0);
 }

@@ -89,22 +89,22 @@ fs::path inside(const std::string& dir, const std::string& requested) {
   return p;
 }
 
-mapsketch::Sketch parseBody(const httplib::Request& req, const std::string& origin,
-                            const std::vector<std::string>& classes) {
-  if (req.body.empty())
+}  // namespace
+
+mapsketch::Sketch sketchFromBody(const std::string& body, const std::string& origin,
+                                 const std::vector<std::string>& classes) {
+  if (body.empty())
     throw InputError(origin + ": empty request body (expected a sketch as JSON)");
-  const std::size_t bad = invalidUtf8At(req.body);
+  const std::size_t bad = invalidUtf8At(body);
   if (bad != std::string::npos) {
-    const std::string field = jsonFieldAt(req.body, bad);
+    const std::string field = jsonFieldAt(body, bad);
     throw InputError(origin + ": " + (field.empty() ? "the sketch" : "'" + field + "'") +
                      " is not valid UTF-8 (byte " + std::to_string(bad) + ")");
   }
-  mapsketch::Sketch s = mapsketch::sketchFromText(req.body, origin);
+  mapsketch::Sketch s = mapsketch::sketchFromText(body, origin);
   mapsketch::validateClasses(s, classes, origin);
   return s;
 }
-
-}  // namespace
 
 std::string safeSketchFileName(const std::string& name) {
   static const std::regex ok(R"([A-Za-z0-9_][A-Za-z0-9_.\-]{0,99})");
@@ -186,7 +186,7 @@ void addEditorRoutes(Server& server, const EditorOptions& o) {
   server.post(R"(/api/sketches/([^/]+))",
               [o, classes](const httplib::Request& req, httplib::Response& res) {
                 const fs::path p = inside(o.sketch_dir, req.matches[1]);
-                const mapsketch::Sketch s = parseBody(req, p.filename().string(), classes);
+                const mapsketch::Sketch s = sketchFromBody(req.body, p.filename().string(), classes);
                 if (fs::exists(p) && req.get_param_value("overwrite") != "1")
                   return sendError(
                       res, 409, "'" + p.filename().string() + "' exists (save again to overwrite)");
@@ -196,7 +196,7 @@ void addEditorRoutes(Server& server, const EditorOptions& o) {
               });
 
   server.post("/api/route", [classes](const httplib::Request& req, httplib::Response& res) {
-    const mapsketch::Sketch s = parseBody(req, "sketch", classes);
+    const mapsketch::Sketch s = sketchFromBody(req.body, "sketch", classes);
     sendJson(res, mapsketch::routeToJson(mapsketch::toRoute(s)));
   });
 }

@@ -37,29 +37,13 @@
 #include <thread>
 #include <vector>
 
+#include "run_request.h"
 #include "server.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
 // clang-format on
 
 namespace sketchnav::ui {
-
-/// What the page asks for. Any of robot/camera/laser/sonar set -> the real robot; otherwise
-/// the simulator with `world` (a name in share/worlds or a world file).
-struct RunRequest {
-  std::string world = "corridor";
-  std::string sketch;  // "" = the world's own sketch
-  std::string robot, camera, laser, sonar;
-  int seed = 1;
-  double max_time_s = 0;     // > 0 caps the run
-  bool camera_only = false;  // open `camera` only and show its frames (capturing, no driving)
-  bool hardware() const {
-    return !robot.empty() || !camera.empty() || !laser.empty() || !sonar.empty();
-  }
-  /// From the POST body; InputError naming the bad field.
-  static RunRequest fromJson(const Json& j);
-  Json toJson() const;
-};
 
 /// How a runner reports to the page. All are set by RunController and called on the run's
 /// thread.
@@ -109,10 +93,6 @@ struct FrameOverlay {
   int windows = -1;
   int detections = -1;
 };
-
-/// A landmark class name a capture may create: letters, digits, '_', '-', '.', ' ', no
-/// leading dot or space, at most 80 characters. InputError otherwise.
-std::string safeClassName(const std::string& name);
 
 class RunController {
  public:

@@ -15,6 +15,10 @@
 
 #include "sketchnav/core/config.h"
 
+namespace sketchnav::mapsketch {
+struct Sketch;
+}
+
 namespace sketchnav::ui {
 
 struct ServerOptions {
@@ -95,6 +99,12 @@ struct EditorOptions {
   std::string examples_dir;   // shipped examples (read-only); "" = none
 };
 void addEditorRoutes(Server& server, const EditorOptions& options);
+
+/// A sketch from a POST body (save, route preview): UTF-8, then the sketch parser, then its
+/// classes against `classes`; InputError naming `origin` and the field otherwise. Public so
+/// the fuzzer (fuzz/entry_webui.cpp) reaches exactly what the routes run.
+mapsketch::Sketch sketchFromBody(const std::string& body, const std::string& origin,
+                                 const std::vector<std::string>& classes);
 
 /// A sketch file name a user may save to: letters, digits, '_', '-', '.', no leading dot,
 /// at most 100 characters; ".sketch.json" is appended when missing. InputError otherwise.

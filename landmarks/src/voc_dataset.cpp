@@ -1,6 +1,7 @@
 // VOC annotation reading (voc.h). The XML subset VOC uses is flat and regular, so a small
 // tag scanner suffices; no XML library is a dependency of this module.
 #include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -33,17 +34,38 @@ std::string trim(const std::string& s) {
   return s.substr(a, b - a + 1);
 }
 
+// Bound on corner coordinates and image sides [px]: far beyond any photograph, and small
+// enough that the int box arithmetic below (corners, widths, clipping) cannot overflow.
+constexpr double kMaxPixels = 1e6;
+
 double number(const std::string& block, const std::string& tag, const std::string& file) {
   std::string t;
   if (!tagText(block, tag, t)) throw InputError(file + ": <bndbox> has no <" + tag + ">");
+  double v = 0;
   try {
     size_t used = 0;
-    const double v = std::stod(trim(t), &used);
+    v = std::stod(trim(t), &used);
     if (used != trim(t).size()) throw std::invalid_argument(t);
-    return v;
   } catch (const std::exception&) {
-    throw InputError(file + ": <" + tag + "> is not a number ('" + trim(t) + "')");
+    throw InputError(file + ": <" + tag + "> is not a number ('" + trim(t).substr(0, 40) + "')");
   }
+  if (!std::isfinite(v) || std::abs(v) > kMaxPixels)
+    throw InputError(file + ": <" + tag + "> " + trim(t).substr(0, 40) +
+                     " is not a pixel coordinate (finite, at most 1000000 in magnitude)");
+  return v;
+}
+
+// <width> / <height> of <size>: absent or empty = unknown (0); otherwise a whole number of
+// pixels 0..kMaxPixels (0 = unknown, as VOC writes for images it never measured).
+int side(const std::string& size_block, const std::string& tag, const std::string& file) {
+  std::string t;
+  if (!tagText(size_block, tag, t) || trim(t).empty()) return 0;
+  t = trim(t);
+  if (t.size() > 7 || t.find_first_not_of("0123456789") != std::string::npos ||
+      std::stod(t) > kMaxPixels)
+    throw InputError(file + ": <size> <" + tag + "> '" + t.substr(0, 40) +
+                     "' is not a pixel count (a whole number 0..1000000)");
+  return std::stoi(t);
 }
 
 }  // namespace
@@ -60,9 +82,7 @@ VocImage readVocAnnotation(const std::string& xml_path) {
   img.id = fs::path(xml_path).stem().string();
   std::string size_block, t;
   if (tagText(s, "size", size_block)) {
-    int w = 0, h = 0;
-    if (tagText(size_block, "width", t)) w = std::atoi(trim(t).c_str());
-    if (tagText(size_block, "height", t)) h = std::atoi(trim(t).c_str());
+    const int w = side(size_block, "width", xml_path), h = side(size_block, "height", xml_path);
     if (w > 0 && h > 0) img.size = cv::Size(w, h);
   }
   size_t pos = 0, end = 0;
@@ -80,7 +100,8 @@ VocImage readVocAnnotation(const std::string& xml_path) {
     cv::Rect r(
         cv::Point(static_cast<int>(std::lround(x0)) - 1, static_cast<int>(std::lround(y0)) - 1),
         cv::Point(static_cast<int>(std::lround(x1)), static_cast<int>(std::lround(y1))));
-    if (img.size.area() > 0) r &= cv::Rect(0, 0, img.size.width, img.size.height);
+    // (not size.area(): width * height may exceed int)
+    if (img.size.width > 0) r &= cv::Rect(0, 0, img.size.width, img.size.height);
     if (r.width <= 0 || r.height <= 0) {
       img.warnings.push_back("object '" + o.name + "' box outside the image or empty: dropped");
       continue;

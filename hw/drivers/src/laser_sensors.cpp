@@ -80,6 +80,13 @@ struct RawlogRangeSensor::Impl {
     if (!label.empty() && o->sensorLabel != label) return;
     RangeScan s;
     if (auto scan = std::dynamic_pointer_cast<CObservation2DRangeScan>(o)) {
+      if (const std::string bad = corruptScanField(*scan); !bad.empty()) {
+        // Like an undecodable entry (fill()): the log ends here.
+        log::warn("rawlog", "stopped at a corrupt laser scan", {{"file", path}, {"field", bad}});
+        ++stats.incomplete;
+        eof = true;
+        return;
+      }
       toRangeScan(*scan, s);
     } else if (auto r = std::dynamic_pointer_cast<mrpt::obs::CObservationRange>(o);
                r && !label.empty()) {

@@ -23,6 +23,7 @@
 #include <deque>
 #include <filesystem>
 #include <mutex>
+#include <vector>
 
 #include "laser_convert.h"
 #include "sketchnav/core/error.h"
@@ -202,11 +203,34 @@ struct RawlogReader::Impl {
         eof = true;
         break;
       }
-      if (obs) pending.push_back(obs);
+      std::vector<mrpt::obs::CObservation::Ptr> got;
+      if (obs) got.push_back(obs);
       if (sf)
-        for (const auto& o : *sf) pending.push_back(o);
+        for (const auto& o : *sf) got.push_back(o);
+      for (const auto& o : got) {
+        const std::string bad = corruptField(*o);
+        if (!bad.empty()) {
+          // Like an undecodable record: the log ends here, everything before is intact.
+          ++truncated;
+          log::warn("rawlog", "log ends at a corrupt record",
+                    {{"file", path}, {"record", std::to_string(entry)}, {"field", bad}});
+          eof = true;
+          break;
+        }
+        pending.push_back(o);
+      }
     }
     return !pending.empty();
+  }
+
+  // The bool fields next() reads, checked as bytes (see boolByte()).
+  static std::string corruptField(const mrpt::obs::CObservation& o) {
+    if (const auto* scan = dynamic_cast<const mrpt::obs::CObservation2DRangeScan*>(&o))
+      return corruptScanField(*scan);
+    if (const auto* odo = dynamic_cast<const mrpt::obs::CObservationOdometry*>(&o))
+      if (const unsigned b = boolByte(odo->hasVelocities); b > 1)
+        return "hasVelocities byte " + std::to_string(b);
+    return {};
   }
 };
 

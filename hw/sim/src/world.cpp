@@ -2,7 +2,9 @@
 // rejects unknown keys (typos would otherwise silently fall back to defaults).
 #include "sketchnav/sim/world.h"
 
+#include <climits>
 #include <cmath>
+#include <cstdint>
 #include <filesystem>
 #include <fstream>
 #include <set>
@@ -57,6 +59,12 @@ class Reader {
     if (!v) return def;
     if (!v->is_number_integer())
       fail(key, "must be an integer (got " + clipForMessage(v->dump()) + ")");
+    // Range-checked as 64 bits first: get<int>() would wrap 4294967297 to 1.
+    const bool fits = v->is_number_unsigned()
+                          ? v->get<std::uint64_t>() <= static_cast<std::uint64_t>(INT_MAX)
+                          : v->get<std::int64_t>() >= INT_MIN && v->get<std::int64_t>() <= INT_MAX;
+    if (!fits)
+      fail(key, "must be an integer within ±2147483647 (got " + clipForMessage(v->dump()) + ")");
     return v->get<int>();
   }
   bool boolean(const std::string& key, bool def) {
@@ -107,8 +115,11 @@ class Reader {
     int rgb[3];
     for (int i = 0; i < 3; ++i) {
       if (!(*v)[i].is_number()) fail(key, "must be [r, g, b] with values 0..255");
-      rgb[i] = (*v)[i].get<int>();
-      if (rgb[i] < 0 || rgb[i] > 255) fail(key, "must be [r, g, b] with values 0..255");
+      // Checked as a double before the conversion: get<int>() of 1.8e105 is undefined (UBSan,
+      // fuzz_world). Fractions truncate as before.
+      const double x = (*v)[i].get<double>();
+      if (!(x >= 0 && x < 256)) fail(key, "must be [r, g, b] with values 0..255");
+      rgb[i] = static_cast<int>(x);
     }
     return cv::Scalar(rgb[2], rgb[1], rgb[0]);
   }
@@ -142,13 +153,20 @@ void eachItem(Reader& r, const std::string& key, F&& f) {
 
 std::string resolveTexture(const std::string& rel, const std::string& base_dir) {
   if (rel.empty()) return {};
+  // error_code overloads: a name the OS refuses (too long: fuzz_world) is "not found" (an
+  // InputError naming the field at the caller), not a filesystem_error escaping the parser.
+  std::error_code ec;
+  const auto found = [&ec](const fs::path& f) -> std::string {
+    if (!fs::exists(f, ec) || ec) return {};
+    const fs::path c = fs::canonical(f, ec);
+    return ec ? std::string() : c.string();
+  };
   const fs::path p(rel);
-  if (p.is_absolute()) return fs::exists(p) ? p.string() : std::string();
-  if (!base_dir.empty() && fs::exists(fs::path(base_dir) / p))
-    return fs::canonical(fs::path(base_dir) / p).string();
+  if (p.is_absolute()) return fs::exists(p, ec) && !ec ? p.string() : std::string();
+  if (!base_dir.empty())
+    if (std::string r = found(fs::path(base_dir) / p); !r.empty()) return r;
   try {
-    const fs::path s = fs::path(resourceDir()) / p;
-    if (fs::exists(s)) return fs::canonical(s).string();
+    return found(fs::path(resourceDir()) / p);
   } catch (const RuntimeError&) {
   }
   return {};
