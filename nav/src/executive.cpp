@@ -900,7 +900,7 @@ struct Executive::Impl {
           endDetour(moving_seen ? "coming towards the robot" : "no way found");
           arb.propose(Behaviour::Avoid, {av.v, av.w, turnOf(av.w)});
         }
-      } else if (detouring && !servoing) {
+      } else if (s.exec.detour_hold && detouring && !servoing) {
         // The avoider has let go (the corridor towards the route is free release_m ahead),
         // but round a box or through a door that is before the robot is past it: heading
         // back to the route from here drives into the same obstacle again. The detour is

@@ -187,6 +187,7 @@ std::vector<std::string> detourEndReasons(const Recorder& r) {
 TEST(Executive, FollowsADetourPastTheObstacleNotOnlyWhileTheAvoiderDodges) {
   Scenario s;
   addBarrier(s.world);
+  s.settings.exec.detour_hold = true;
   const auto sum = s.run();
   ASSERT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
   EXPECT_LT(s.distToGoal(), 0.6);
@@ -199,7 +200,7 @@ TEST(Executive, FollowsADetourPastTheObstacleNotOnlyWhileTheAvoiderDodges) {
   ASSERT_FALSE(reasons.empty());
   EXPECT_EQ(reasons.front(), "route clear");
 
-  // Ending with the avoider's manoeuvre (the behaviour before detour_hold), the first detour
+  // Ending with the avoider's manoeuvre (detour_hold off, the default), the first detour
   // ends while the robot is still in front of the barrier.
   Scenario off;
   addBarrier(off.world);

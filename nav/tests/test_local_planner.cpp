@@ -102,7 +102,9 @@ TEST(LocalPlanner, GoalAgainstAWallMovesOutOfItsClearance) {
 }
 
 TEST(LocalPlanner, EnclosedGoalIsNotFound) {
-  LocalPlanner p;
+  PlannerParams wide;  // a wider window could be tried, but no wider window can help
+  wide.max_window_margin_m = 12;
+  LocalPlanner p(wide);
   auto boxes = room();
   // A closed pen round (5, 0).
   boxes.push_back({5, 1.5, 1.5, 0.05});
@@ -124,7 +126,9 @@ TEST(LocalPlanner, WidensTheWindowToFindTheWayRoundALongBlockage) {
       {3, -12, 15, 0.05}, {3, 12, 15, 0.05}, {-12, 0, 0.05, 12}, {18, 0, 0.05, 12}};
   auto boxes = hall;
   boxes.push_back({3, 0, 0.05, 5.5});
-  LocalPlanner p;
+  PlannerParams wide;
+  wide.max_window_margin_m = 12;
+  LocalPlanner p(wide);
   look(p, {{0, 0, 0}, {0, 4, 0}, {0, -4, 0}, {6, 0, M_PI}, {6, 4, M_PI}, {6, -4, M_PI}}, boxes);
   const auto path = p.plan({0, 0}, {6, 0});
   ASSERT_TRUE(path.found);

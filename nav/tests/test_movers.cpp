@@ -23,6 +23,7 @@ MoverTracker watch(LocalPlanner& grid, const hw::Pose2D& robot, Eigen::Vector2d 
   for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
   MoverParams on;
   on.enabled = enabled;
+  on.follow_gap_m = 1.5;  // the setting measured in doc/navigation.md
   MoverTracker tr(on);
   const LocalPlanner before = grid.snapshot();  // the grid before the person walked in
   for (double t = 0.5; t <= 0.5 + secs + 1e-9; t += 0.1) {

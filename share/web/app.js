@@ -20,6 +20,7 @@ let selectedId = null;     // selected landmark
 let tool = 'select';
 let history = [];
 let route = null;          // last converted route (server JSON)
+let routePending = false;  // an edit's route is still being converted (debounce or request)
 let routeError = '';
 let drag = null;           // current pointer interaction
 let dirty = false;         // edits since the last save / open
@@ -360,11 +361,13 @@ function changed(edit = true) {
   if (edit) dirty = true;
   render();
   clearTimeout(routeTimer);
+  routePending = true;
   routeTimer = setTimeout(updateRoute, 120);
 }
 
 async function updateRoute() {
   if (!state.landmarks.length || state.path.length < 2) {
+    routePending = false;
     route = null;
     routeError = !state.landmarks.length ? 'Add at least one landmark.' : 'Draw the guide path (Draw path tool).';
     render();
@@ -382,6 +385,7 @@ async function updateRoute() {
     if (seq !== routeSeq) return;
     route = null; routeError = 'server not reachable: ' + e.message;
   }
+  routePending = false;
   render();
 }
 

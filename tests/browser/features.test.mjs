@@ -327,6 +327,8 @@ try {
     await openEditor();
     await page.click('#new');
     await page.selectOption('#world', 'corridor');
+    // The world's map is fetched asynchronously: wait for this world's, not any walls drawn.
+    await page.waitForFunction(() => worldMap && worldMap.name === 'corridor' && worldMap.geometry);
     await page.waitForSelector('#layer-world line.w-wall', { state: 'attached' });
     assert.match(await page.textContent('#bg-note'), /fitted into the canvas until there is a route/);
     // Trace the corridor: from the world's start 8 m ahead to its goal, the landmark on the end wall.
@@ -343,13 +345,17 @@ try {
     await page.fill('#dist-input', '8.9');
     await page.keyboard.press('Enter');
     await page.waitForSelector('.lm[data-id="L1"]');
-    const box = await page.locator('.lm[data-id="L1"] rect.box').boundingBox();
+    // Grab the landmark where the page's state has it (a DOM box can be of an element a
+    // redraw has replaced), and read the route converted after the drop, not the one of the
+    // add: the conversion is debounced and asynchronous (routePending).
+    const c = await page.evaluate(() => { const l = state.landmarks.find((x) => x.id === 'L1'); return [l.x + l.w / 2, l.y + l.h / 2]; });
+    const from = await toScreen(...c);
     const to = await toScreen(f[2][0] - 40, f[2][1]);
-    await page.mouse.move(box.x + box.width / 2, box.y + box.height / 2);
+    await page.mouse.move(from[0], from[1]);
     await page.mouse.down();
     await page.mouse.move(to[0], to[1], { steps: 6 });
     await page.mouse.up();
-    await page.waitForFunction(() => route && route.sections.length >= 1 && /placed as the robot reads/.test(document.getElementById('bg-note').textContent));
+    await page.waitForFunction(() => !routePending && route && route.sections.length >= 1 && /placed as the robot reads/.test(document.getElementById('bg-note').textContent));
     // Traced at the map's scale, the distances give (nearly) the same one: the map stays put.
     const k = await page.evaluate(() => 1 / route.scale_m_per_px);
     // (the landmark sits 40 px short of the end wall and the scale fit weighs the drawing: within 20 %)

@@ -144,7 +144,8 @@ struct ExecutiveParams {
   // over), not only while the reactive avoider is dodging: the avoider lets go when the
   // corridor towards the route is free avoid.release_m ahead, which round a box or a door
   // frame comes before the robot is past it. false = ends with the avoider's manoeuvre.
-  bool detour_hold = true;
+  // Off by default: doc/navigation.md "Evidence for the defaults".
+  bool detour_hold = false;
   double replan_s = 0.5;        // [s]
   template <class B>
   void bind(B& b) {

@@ -34,8 +34,9 @@ struct PlannerParams {
   double occupied_p = 0.65;      // occupancy probability above which a cell is an obstacle
   double max_insert_m = 6.0;     // [m] laser readings further than this do not mark the grid
   double window_margin_m = 3.0;  // [m] planning window: box round start and goal plus this
-  double max_window_margin_m = 12.0;  // [m] with no way found and the search stopped by the
-                                      // window's edge, the margin doubles up to this
+  double max_window_margin_m = 3.0;  // [m] with no way found and the search stopped by the
+                                     // window's edge, the margin doubles up to this (12 m:
+                                     // see doc/navigation.md "Evidence for the defaults")
   double goal_snap_m = 1.0;      // [m] a goal within an obstacle's clearance moves to the
                                  // nearest clear cell at most this far
   double carrot_m = 0.7;         // [m] path-following look-ahead

@@ -44,8 +44,9 @@ struct MoverParams {
   // Walking behind someone (followSpeed(), applied whether or not `enabled`): the robot keeps
   // follow_gap_m between the two bodies, closing a larger gap at most at 1 / follow_time_s of
   // the excess. A person who turns round then has seconds, not a metre, to be got out of the
-  // way of. 0 = off.
-  double follow_gap_m = 1.5;   // [m]
+  // way of. 0 = off (the default: doc/navigation.md "Evidence for the defaults"; 1.5 m is
+  // the setting measured there).
+  double follow_gap_m = 0;     // [m]
   double follow_time_s = 2.0;  // [s]
   template <class B>
   void bind(B& b) {
