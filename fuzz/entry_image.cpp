@@ -1,9 +1,5 @@
 #include "entry_points.h"
 
-#include <unistd.h>
-
-#include <fstream>
-
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
 
@@ -13,15 +9,8 @@ namespace sketchnav::fuzz {
 // regular-file and size rule, the header probe and pixel bound, then OpenCV's decoder), in
 // both modes. Whatever it returns must hold what the header promises to its callers.
 void image(const std::uint8_t* d, std::size_t n) {
-  // A per-process file in /dev/shm (or /tmp) keeps this cheap.
-  static const std::string path = [] {
-    const std::string dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return dir + "/sketchnav-fuzz-image-" + std::to_string(::getpid()) + ".img";
-  }();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n));
-  }
+  static const std::string path = scratchPath("image", ".img");
+  writeInput(path, d, n);
   for (const ImageMode mode : {ImageMode::Colour, ImageMode::Unchanged}) {
     refusedIsFine([&] {
       const cv::Mat img = readImageFile(path, "image", mode);

@@ -3,8 +3,11 @@
 // `fuzz`) and the normal regression test that replays fuzz/regressions/ and the seeds
 // (test_fuzz_corpus). Each returns normally for input that is accepted or refused with an
 // InputError; anything else (a crash, another exception, a sanitizer report) is a finding.
+#include <unistd.h>
+
 #include <cstddef>
 #include <cstdint>
+#include <fstream>
 #include <string>
 
 #include "sketchnav/core/error.h"
@@ -14,6 +17,19 @@ namespace sketchnav::fuzz {
 /// The input bytes as a string.
 inline std::string text(const std::uint8_t* d, std::size_t n) {
   return std::string(reinterpret_cast<const char*>(d), n);
+}
+
+/// For parsers that read files: this process's scratch file for `name`, in /dev/shm when it is
+/// writable (cheap), else /tmp. Callers keep it in a static and rewrite it per input.
+inline std::string scratchPath(const std::string& name, const std::string& ext) {
+  const std::string dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
+  return dir + "/sketchnav-fuzz-" + name + "-" + std::to_string(::getpid()) + ext;
+}
+
+/// Replaces the file at `path` with the input bytes.
+inline void writeInput(const std::string& path, const std::uint8_t* d, std::size_t n) {
+  std::ofstream out(path, std::ios::binary | std::ios::trunc);
+  out.write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n));
 }
 
 /// Runs `f`; an InputError is the promised outcome for bad input, so it is swallowed, while any

@@ -1,9 +1,5 @@
 #include "entry_points.h"
 
-#include <unistd.h>
-
-#include <fstream>
-
 #include "sketchnav/core/error.h"
 #include "sketchnav/drivers/rawlog.h"
 
@@ -13,14 +9,8 @@ namespace sketchnav::fuzz {
 // deserialisation of each record, then the conversion to the project's types), images
 // included (their external files are missing here, which the reader must tolerate).
 void rawlog(const std::uint8_t* d, std::size_t n) {
-  static const std::string path = [] {
-    const std::string dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return dir + "/sketchnav-fuzz-rawlog-" + std::to_string(::getpid()) + ".rawlog";
-  }();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n));
-  }
+  static const std::string path = scratchPath("rawlog", ".rawlog");
+  writeInput(path, d, n);
   refusedIsFine([&] {
     drivers::RawlogReader r(path);
     drivers::RawlogEntry e;

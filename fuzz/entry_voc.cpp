@@ -1,9 +1,5 @@
 #include "entry_points.h"
 
-#include <unistd.h>
-
-#include <fstream>
-
 #include "sketchnav/core/error.h"
 #include "sketchnav/landmarks/voc.h"
 
@@ -13,14 +9,8 @@ namespace sketchnav::fuzz {
 // What it returns must hold what voc.h promises: boxes non-empty and, when the image size is
 // known, inside the image.
 void voc(const std::uint8_t* d, std::size_t n) {
-  static const std::string path = [] {
-    const std::string dir = access("/dev/shm", W_OK) == 0 ? "/dev/shm" : "/tmp";
-    return dir + "/sketchnav-fuzz-voc-" + std::to_string(::getpid()) + ".xml";
-  }();
-  {
-    std::ofstream out(path, std::ios::binary | std::ios::trunc);
-    out.write(reinterpret_cast<const char*>(d), static_cast<std::streamsize>(n));
-  }
+  static const std::string path = scratchPath("voc", ".xml");
+  writeInput(path, d, n);
   refusedIsFine([&] {
     const landmarks::VocImage img = landmarks::readVocAnnotation(path);
     const cv::Rect frame(0, 0, img.size.width, img.size.height);
