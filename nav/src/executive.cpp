@@ -314,15 +314,8 @@ struct Executive::Impl {
     if (dev.camera) half_fov = std::atan2(0.5 * K.width, K.fx);
     for (const auto& sec : tracker.route().sections) tracks.emplace_back(sec.landmarks.size());
     if (s.avoid.approach_needs_free_floor)
-      avoider.setMovedInTest([this](const Eigen::Vector2d& p) {
-        // The point and its neighbours one cell round: a static surface's point often falls
-        // in the free cell in front of the wall's own cells.
-        const double c = grid_before.params().cell_m;
-        for (int i = -1; i <= 1; ++i)
-          for (int j = -1; j <= 1; ++j)
-            if (!grid_before.seenFree(p + Eigen::Vector2d(i * c, j * c))) return false;
-        return true;
-      });
+      avoider.setMovedInTest(
+          [this](const Eigen::Vector2d& p) { return grid_before.seenFreeAround(p); });
   }
 
   void event(EventData d) {
@@ -891,40 +884,33 @@ struct Executive::Impl {
             ++detours;
             event(event::DetourStart{detour.length_m, detour.goal, detour.goal_moved, k});
           }
-          Command c;
-          headFor(b, 1.0, c.v, c.w);
-          c.v = avoider.capSpeed(scans, c.v);
-          c.turn = turnOf(c.w);
-          arb.propose(Behaviour::Detour, c);
+          arb.propose(Behaviour::Detour, detourCommand(b));
         } else {
           endDetour(moving_seen ? "coming towards the robot" : "no way found");
           arb.propose(Behaviour::Avoid, {av.v, av.w, turnOf(av.w)});
         }
-      } else if (s.exec.detour_hold && detouring && !servoing) {
-        // The avoider has let go (the corridor towards the route is free release_m ahead),
-        // but round a box or through a door that is before the robot is past it: heading
-        // back to the route from here drives into the same obstacle again. The detour is
-        // followed until the straight line to the route point it leads to is clear.
-        const Eigen::Vector2d to = tracker.lookahead(pose, s.exec.detour_ahead_m);
-        const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-        const double b = planTowards(to);
-        if (planner.segmentClear({pose.x, pose.y}, to, hwid)) {
-          endDetour("route clear");
-          arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
-        } else if (!std::isfinite(b)) {
-          endDetour("no way found");
-          arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
-        } else {
-          dodging = true;
-          Command c;
-          headFor(b, 1.0, c.v, c.w);
-          c.v = avoider.capSpeed(scans, c.v);
-          c.turn = turnOf(c.w);
-          arb.propose(Behaviour::Detour, c);
-        }
       } else {
-        if (servoing) endDetour("servoing");
-        arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
+        bool held = false;
+        if (s.exec.detour_hold && detouring && !servoing) {
+          // The avoider has let go (the corridor towards the route is free release_m ahead),
+          // but round a box or through a door that is before the robot is past it: heading
+          // back to the route from here drives into the same obstacle again. The detour is
+          // followed until the straight line to the route point it leads to is clear.
+          const Eigen::Vector2d to = tracker.lookahead(pose, s.exec.detour_ahead_m);
+          const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
+          const double b = planTowards(to);
+          if (planner.segmentClear({pose.x, pose.y}, to, hwid)) {
+            endDetour("route clear");
+          } else if (!std::isfinite(b)) {
+            endDetour("no way found");
+          } else {
+            dodging = held = true;
+            arb.propose(Behaviour::Detour, detourCommand(b));
+          }
+        } else if (servoing) {
+          endDetour("servoing");
+        }
+        if (!held) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
       }
     } else {
       endDetour("no range data");
@@ -1139,6 +1125,15 @@ struct Executive::Impl {
     const Eigen::Vector2d c =
         LocalPlanner::carrot(detour, {pose.x, pose.y}, planner.params().carrot_m);
     return polarFrom(pose, c).bearing;
+  }
+  // Along a planned detour: towards bearing `b` [rad, robot frame] of its carrot, the speed
+  // capped by the clearance ahead.
+  Command detourCommand(double b) {
+    Command c;
+    headFor(b, 1.0, c.v, c.w);
+    c.v = avoider.capSpeed(scans, c.v);
+    c.turn = turnOf(c.w);
+    return c;
   }
   void endDetour(const char* reason) {
     if (!detouring) return;

@@ -99,6 +99,14 @@ bool LocalPlanner::seenFree(const Eigen::Vector2d& p) const {
          params_.occupied_p;
 }
 
+bool LocalPlanner::seenFreeAround(const Eigen::Vector2d& p) const {
+  const double c = params_.cell_m;
+  for (int i = -1; i <= 1; ++i)
+    for (int j = -1; j <= 1; ++j)
+      if (!seenFree(p + Eigen::Vector2d(i * c, j * c))) return false;
+  return true;
+}
+
 bool LocalPlanner::segmentClear(const Eigen::Vector2d& a, const Eigen::Vector2d& b,
                                 double clearance) const {
   const double c = params_.cell_m;

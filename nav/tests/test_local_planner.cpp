@@ -41,6 +41,18 @@ TEST(LocalPlanner, GridMarksWhatTheLaserSees) {
   EXPECT_EQ(p.scansInserted(), 1);
 }
 
+TEST(LocalPlanner, OpenFloorIsFreeAllRoundNotJustInFrontOfASurface) {
+  LocalPlanner p;
+  auto boxes = room();
+  boxes.push_back({3, 0, 0.3, 0.3});
+  for (int i = 0; i < 5; ++i) look(p, {{0, 0, 0}}, boxes);
+  EXPECT_TRUE(p.seenFreeAround({1.5, 0.0}));
+  // The cell just in front of the box's near face (2.7 m) was seen free, the next is the box.
+  EXPECT_TRUE(p.seenFree({2.62, 0.0}));
+  EXPECT_FALSE(p.seenFreeAround({2.62, 0.0}));
+  EXPECT_FALSE(p.seenFreeAround({9.0, 0.0}));  // beyond the room: never seen
+}
+
 TEST(LocalPlanner, GoesRoundAnObstacleKeepingClearance) {
   LocalPlanner p;
   auto boxes = room();

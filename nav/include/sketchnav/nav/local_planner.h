@@ -92,6 +92,10 @@ class LocalPlanner {
   /// Whether the cell at `p` has been seen as free floor (a laser point there now is
   /// something that moved in: movers.h).
   bool seenFree(const Eigen::Vector2d& p) const;
+  /// Whether the cell at `p` and the 8 round it have all been seen free: a point there stands
+  /// on open floor (a static surface's laser point often falls in the free cell just in front
+  /// of the surface's own cells, which seenFree() alone would take for floor).
+  bool seenFreeAround(const Eigen::Vector2d& p) const;
   /// The point `dist` along `path` beyond the path point nearest to `at`.
   static Eigen::Vector2d carrot(const PlannedPath& path, const Eigen::Vector2d& at, double dist);
 
