@@ -15,7 +15,8 @@ void rawlog(const std::uint8_t* d, std::size_t n) {
     drivers::RawlogReader r(path);
     drivers::RawlogEntry e;
     for (int i = 0; i < 100000 && r.next(e, true); ++i) {
-      if (e.kind == drivers::RawlogEntry::Kind::Range && e.range.angles.size() != e.range.ranges.size())
+      if (e.kind == drivers::RawlogEntry::Kind::Range &&
+          e.range.angles.size() != e.range.ranges.size())
         __builtin_trap();
     }
   });

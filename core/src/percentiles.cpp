@@ -22,7 +22,9 @@ double PercentileAccumulator::mean() const {
   return samples_.empty() ? kNaN : sum_ / static_cast<double>(samples_.size());
 }
 
-double PercentileAccumulator::max() const { return samples_.empty() ? kNaN : max_; }
+double PercentileAccumulator::max() const {
+  return samples_.empty() ? kNaN : max_;
+}
 
 double nearestRankQuantile(const std::vector<double>& sorted, double q) {
   if (!(q >= 0 && q <= 1)) throw std::invalid_argument("quantile: q must be in [0, 1]");

@@ -13,7 +13,8 @@ void MoverParams::validate() const {
   require(cluster_gap_m > 0, "nav.movers.cluster_gap_m", "must be > 0");
   require(max_width_m > 0, "nav.movers.max_width_m", "must be > 0");
   require(gate_m > 0, "nav.movers.gate_m", "must be > 0");
-  require(follow_gap_m >= 0 && follow_gap_m <= 10, "nav.movers.follow_gap_m", "must be in [0, 10] m");
+  require(follow_gap_m >= 0 && follow_gap_m <= 10, "nav.movers.follow_gap_m",
+          "must be in [0, 10] m");
   require(follow_time_s > 0, "nav.movers.follow_time_s", "must be > 0 s");
   require(min_speed > 0, "nav.movers.min_speed", "must be > 0");
   require(min_updates >= 2, "nav.movers.min_updates", "must be >= 2");
@@ -200,7 +201,7 @@ double MoverTracker::followSpeed(const hw::Pose2D& robot, double v) const {
     const double along = d.dot(u), lateral = std::abs(u.x() * d.y() - u.y() * d.x());
     if (along <= 0 || along > p_.range_m || lateral > reach + p_.margin_m) continue;
     const double away = tr.fit_vel.dot(u);  // its speed along the robot's heading
-    if (away < 0.5 * sp) continue;           // not walking the same way: the avoider's case
+    if (away < 0.5 * sp) continue;          // not walking the same way: the avoider's case
     const double gap = along - reach;
     cap = std::min(cap, std::max(0.0, away + (gap - p_.follow_gap_m) / p_.follow_time_s));
   }

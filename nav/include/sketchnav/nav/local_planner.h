@@ -37,9 +37,9 @@ struct PlannerParams {
   double max_window_margin_m = 3.0;  // [m] with no way found and the search stopped by the
                                      // window's edge, the margin doubles up to this (12 m:
                                      // see doc/navigation.md "Evidence for the defaults")
-  double goal_snap_m = 1.0;      // [m] a goal within an obstacle's clearance moves to the
-                                 // nearest clear cell at most this far
-  double carrot_m = 0.7;         // [m] path-following look-ahead
+  double goal_snap_m = 1.0;          // [m] a goal within an obstacle's clearance moves to the
+                                     // nearest clear cell at most this far
+  double carrot_m = 0.7;             // [m] path-following look-ahead
   template <class B>
   void bind(B& b) {
     b("cell_m", cell_m);
