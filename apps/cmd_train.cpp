@@ -4,6 +4,8 @@
 #include <cstdio>
 #include <iostream>
 
+#include <unistd.h>
+
 #include "cli.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/input_file.h"
@@ -43,15 +45,29 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
 
   const auto t0 = std::chrono::steady_clock::now();
   std::string last_stage;
+  // On a terminal one line is rewritten in place; into a log file (not a terminal) a carriage
+  // return per photo would pile hundreds of updates onto one line, so a line is written per
+  // tenth of each stage instead.
+  const bool tty = isatty(STDERR_FILENO) != 0;
+  int last_tenth = -1;
   auto progress = [&](const std::string& stage, int done, int total) {
     if (g.json && !g.verbose) return;
-    if (stage != last_stage && !last_stage.empty()) std::cerr << "\n";
+    const bool new_stage = stage != last_stage;
+    if (tty) {
+      if (new_stage && !last_stage.empty()) std::cerr << "\n";
+      last_stage = stage;
+      std::cerr << "\rtrain: " << stage << " " << done << "/" << total << std::flush;
+      return;
+    }
+    const int tenth = total > 0 ? 10 * done / total : 10;
+    if (!new_stage && tenth == last_tenth) return;
     last_stage = stage;
-    std::cerr << "\rtrain: " << stage << " " << done << "/" << total << std::flush;
+    last_tenth = tenth;
+    std::cerr << "train: " << stage << " " << done << "/" << total << "\n" << std::flush;
   };
   landmarks::LandmarkModel m =
       landmarks::trainModel(args.get("landmarks"), p, progress, args.getList("exclude"));
-  if (!last_stage.empty() && !(g.json && !g.verbose)) std::cerr << "\n";
+  if (tty && !last_stage.empty() && !(g.json && !g.verbose)) std::cerr << "\n";
   m.save(args.get("output"));
   const double secs = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
   // Per class: its photos and keypoints, and what would make it weak (the photos a user has to

@@ -1250,7 +1250,13 @@ struct Executive::Impl {
             markMissed(kk, ii, false);
         }
     missed_in_row = 0;
-    event::LandmarkPassed e{lm.id, lm.class_name, k, tr.last_range, tr.frames_seen, seen_close};
+    event::LandmarkPassed e;
+    e.id = lm.id;
+    e.class_name = lm.class_name;
+    e.section = k;
+    e.range_m = tr.last_range;
+    e.frames_seen = tr.frames_seen;
+    e.in_view = seen_close;
     // Where the landmark really is (odometry frame: its bearings crossed, and the ranges that
     // agree) vs where the sketch puts it: refit or rotate the route, then shift it, each by
     // its gain. A landmark that slid out of view when close was seen as well as one passed in

@@ -990,7 +990,13 @@ function init() {
   fitView();
   setTool('select');
   render();
-  loadClasses().then(() => { render(); setStatus('Pick a landmark class on the left and press Add.'); });
+  // The greeting replaces only the page's initial "Ready.": a message an action wrote while
+  // the class list was loading (an error from a click, say) must stay readable.
+  const greeting = $('status').textContent;
+  loadClasses().then(() => {
+    render();
+    if ($('status').textContent === greeting) setStatus('Pick a landmark class on the left and press Add.');
+  });
   refreshFileList();
   loadWorlds();
 }

@@ -25,6 +25,14 @@ if(NOT weak EQUAL 2 OR NOT oatly_photos EQUAL 1 OR NOT oatly_warning MATCHES "fe
                       "(1), warning '${oatly_warning}':\n${out}")
 endif()
 
+# Progress into a log file (stderr not a terminal): whole lines, one per tenth of a stage at
+# most, no carriage returns piling every update onto one line.
+run_ok(out err train --landmarks ${WORK}/eval -o ${WORK}/small2.slm)
+string(FIND "${err}" "\r" cr)
+if(NOT cr EQUAL -1 OR NOT err MATCHES "train: features 4/4\n" OR NOT err MATCHES "train: vocabulary 1/1\n")
+  message(FATAL_ERROR "train progress into a file is not whole lines:\n${err}")
+endif()
+
 # PNG signature and the IHDR chunk's width and height.
 function(png_size file out_w out_h)
   if(NOT EXISTS ${file})

@@ -88,32 +88,38 @@ struct LandmarkMissed {
   bool seen_before = false;
 };
 /// A landmark passed, with the fix it gave and what the route did with it (when located).
+// The parts of a LandmarkPassed event's fix. They are declared outside LandmarkPassed so that
+// they are complete types where std::optional asks whether they are default-constructible
+// (clang rejects optional<Nested>::emplace() for a nested struct with member initialisers).
+struct PassedRefit {  // least-squares refit of the route (SectionTracker::fitSimilarity*)
+  double rotation_deg = 0, scale = 1, rms_m = 0;
+  std::size_t fixes = 0;
+  int dropped = 0;
+};
+struct PassedRealign {  // before enough fixes: rotate about the previous fix, then shift
+  double realign_deg = 0, reanchor_m = 0;
+};
+struct PassedFix {
+  std::string method;  // "ranges", "bearings", "bearing only"
+  int rays = 0, ranges_used = 0, height_ranges = 0, ranges_dropped = 0;
+  double height_sigma_m = 0;  // written only when height_ranges > 0
+  // Sightings (origin x, y [m], direction [rad], range [m]), odometry frame, unrounded.
+  std::vector<std::array<double, 4>> sightings;
+  std::optional<PassedRefit> fit;  // one of fit / realign
+  std::optional<PassedRealign> realign;
+  double disagreement_m = 0;                // route's landmark to the fix, before correcting
+  Eigen::Vector2d route{0, 0}, odom{0, 0};  // the sketch's point and the located one
+};
 struct LandmarkPassed {
+  using Refit = PassedRefit;
+  using Realign = PassedRealign;
+  using Fix = PassedFix;
   std::string id, class_name;
   int section = 0;
   double range_m = 0;  // last measured range
   int frames_seen = 0;
   bool in_view = false;  // passed while servoed in view (else: slid out of view, or behind)
   std::optional<std::string> fix_rejected;  // why the fix was not used
-  struct Refit {  // least-squares refit of the route (SectionTracker::fitSimilarity*)
-    double rotation_deg = 0, scale = 1, rms_m = 0;
-    std::size_t fixes = 0;
-    int dropped = 0;
-  };
-  struct Realign {  // before enough fixes: rotate about the previous fix, then shift
-    double realign_deg = 0, reanchor_m = 0;
-  };
-  struct Fix {
-    std::string method;  // "ranges", "bearings", "bearing only"
-    int rays = 0, ranges_used = 0, height_ranges = 0, ranges_dropped = 0;
-    double height_sigma_m = 0;  // written only when height_ranges > 0
-    // Sightings (origin x, y [m], direction [rad], range [m]), odometry frame, unrounded.
-    std::vector<std::array<double, 4>> sightings;
-    std::optional<Refit> fit;  // one of fit / realign
-    std::optional<Realign> realign;
-    double disagreement_m = 0;                // route's landmark to the fix, before correcting
-    Eigen::Vector2d route{0, 0}, odom{0, 0};  // the sketch's point and the located one
-  };
   std::optional<Fix> fix;
 };
 struct SectionDone {
