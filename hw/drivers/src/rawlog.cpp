@@ -6,17 +6,15 @@
 #include <mrpt/core/Clock.h>
 #include <mrpt/io/CFileGZInputStream.h>
 #include <mrpt/io/CMemoryStream.h>
-#include <mrpt/obs/CActionCollection.h>
 #include <mrpt/obs/CObservation2DRangeScan.h>
 #include <mrpt/obs/CObservationImage.h>
 #include <mrpt/obs/CObservationOdometry.h>
 #include <mrpt/obs/CObservationRange.h>
-#include <mrpt/obs/CRawlog.h>
-#include <mrpt/obs/CSensoryFrame.h>
 #include <mrpt/serialization/CArchive.h>
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstring>
@@ -26,6 +24,7 @@
 #include <vector>
 
 #include "laser_convert.h"
+#include "rawlog_record.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
@@ -182,45 +181,57 @@ struct RawlogReader::Impl {
   bool eof = false;
   std::uint64_t truncated = 0;
   std::deque<mrpt::obs::CObservation::Ptr> pending;
+  std::vector<std::uint8_t> bytes;  // the record being read
 
   bool fetch() {
     while (pending.empty() && !eof) {
-      mrpt::obs::CActionCollection::Ptr action;
-      mrpt::obs::CSensoryFrame::Ptr sf;
-      mrpt::obs::CObservation::Ptr obs;
-      auto arch = mrpt::serialization::archiveFrom(file);
-      bool ok = false;
-      try {
-        ok =
-            mrpt::obs::CRawlog::getActionObservationPairOrObservation(arch, action, sf, obs, entry);
-      } catch (const std::exception& e) {
-        // The tail of a killed recording: everything before it is intact.
-        ++truncated;
-        log::warn("rawlog", "log ends with an incomplete record", {{"file", path}});
-        ok = false;
-      }
-      if (!ok) {
+      // The record's bytes first, every length in them checked (rawlog_record.h); MRPT then
+      // deserialises from those bytes only, so no length field can make it allocate more.
+      const RawlogRecordRead got = readRawlogRecord(file, bytes);
+      if (got.status == RawlogRecordRead::Status::End) {
         eof = true;
         break;
       }
-      std::vector<mrpt::obs::CObservation::Ptr> got;
-      if (obs) got.push_back(obs);
-      if (sf)
-        for (const auto& o : *sf) got.push_back(o);
-      for (const auto& o : got) {
-        const std::string bad = corruptField(*o);
-        if (!bad.empty()) {
-          // Like an undecodable record: the log ends here, everything before is intact.
-          ++truncated;
-          log::warn("rawlog", "log ends at a corrupt record",
-                    {{"file", path}, {"record", std::to_string(entry)}, {"field", bad}});
-          eof = true;
-          break;
-        }
-        pending.push_back(o);
+      ++entry;
+      if (got.status == RawlogRecordRead::Status::Incomplete) {
+        // The tail of a killed recording: everything before it is intact.
+        end("log ends with an incomplete record", got.field);
+        break;
       }
+      if (got.status == RawlogRecordRead::Status::Corrupt) {
+        end("log ends at a corrupt record", got.field);
+        break;
+      }
+      mrpt::io::CMemoryStream mem;
+      mem.assignMemoryNotOwn(bytes.data(), bytes.size());
+      auto arch = mrpt::serialization::archiveFrom(mem);
+      mrpt::obs::CObservation::Ptr obs;
+      std::string bad;
+      try {
+        obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(arch.ReadObject());
+        if (mem.getPosition() != bytes.size()) bad = "record layout (MRPT read a different length)";
+      } catch (const std::exception& e) {
+        const std::string what = e.what();
+        bad =
+            "record layout (MRPT: " + what.substr(0, std::min(what.find('\n'), std::size_t{120})) +
+            ")";
+      }
+      if (bad.empty() && obs) bad = corruptField(*obs);
+      if (!bad.empty() || !obs) {
+        // Like an undecodable record: the log ends here, everything before is intact.
+        end("log ends at a corrupt record", bad.empty() ? "record class" : bad);
+        break;
+      }
+      pending.push_back(obs);
     }
     return !pending.empty();
+  }
+
+  void end(const char* message, const std::string& field) {
+    ++truncated;
+    eof = true;
+    log::warn("rawlog", message,
+              {{"file", path}, {"record", std::to_string(entry)}, {"field", field}});
   }
 
   // The bool fields next() reads, checked as bytes (see boolByte()).

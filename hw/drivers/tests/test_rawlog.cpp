@@ -1,16 +1,22 @@
 // Recording to an MRPT rawlog and reading it back, including after the recorder was killed.
 #include <gtest/gtest.h>
 #include <signal.h>
+#include <sys/resource.h>
 #include <sys/wait.h>
 #include <unistd.h>
 
 #include <opencv2/core.hpp>
 
 #include <chrono>
+#include <cstring>
 #include <filesystem>
+#include <fstream>
+#include <functional>
+#include <iterator>
 #include <thread>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
 #include "sketchnav/drivers/rawlog.h"
 #include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
@@ -42,6 +48,23 @@ RangeScan makeLaser() {
   }
   s.stamp = 100.05;
   return s;
+}
+std::string fileBytes(const std::string& path) {
+  std::ifstream f(path, std::ios::binary);
+  return {std::istreambuf_iterator<char>(f), std::istreambuf_iterator<char>()};
+}
+// One record exactly as RawlogRecorder writes it.
+std::string recordOf(const std::string& dir, const std::function<void(RawlogRecorder&)>& add) {
+  const std::string path = dir + "/one.rawlog";
+  {
+    RawlogRecorder rec(path);
+    add(rec);
+  }
+  return fileBytes(path);
+}
+void putU32(std::string& bytes, std::size_t at, std::uint32_t v) {
+  ASSERT_LE(at + 4, bytes.size());
+  std::memcpy(&bytes[at], &v, 4);
 }
 }  // namespace
 
@@ -218,4 +241,77 @@ TEST(Rawlog, AKilledRecorderLeavesALogReadableUpToItsLastRecord) {
   while (cut.next(e, false)) ++n;
   EXPECT_GE(n, frames + odos - 1);
   EXPECT_LE(cut.truncated(), 1u);
+}
+
+TEST(Rawlog, ARecordWhoseLengthFieldClaimsGigabytesEndsTheLogWithoutBeingAllocated) {
+  const std::string dir = test::tempDir("rawlog-huge");
+  Odometry o;
+  o.stamp = 100.0;
+  const std::string odo = recordOf(dir, [&](RawlogRecorder& r) { r.addOdometry(o); });
+  RangeScan sonar;
+  sonar.kind = RangeScan::Kind::Sonar;
+  sonar.angles = {0.0f, 0.5f};
+  sonar.ranges = {1.5f, 3.0f};
+  sonar.max_range = 3.0f;
+  std::string sonar_rec = recordOf(dir, [&](RawlogRecorder& r) { r.addRange(sonar); });
+  std::string laser_rec = recordOf(dir, [&](RawlogRecorder& r) { r.addRange(makeLaser()); });
+  // CObservationRange: header byte, class name, version, three floats, then the count.
+  const std::string range_class = "mrpt::obs::CObservationRange";
+  ASSERT_EQ(sonar_rec.substr(1, range_class.size()), range_class);
+  putU32(sonar_rec, 1 + range_class.size() + 1 + 3 * 4, 0xF0000000u);
+  // The scan's sensorLabel: its length field sits just before the label.
+  const std::size_t label = laser_rec.rfind("LASER");
+  ASSERT_NE(label, std::string::npos);
+  putU32(laser_rec, label - 4, 0xE0000000u);
+
+  const struct {
+    std::string name, record, field;
+  } cases[] = {{"sonar-count", sonar_rec, "field=\"sensedData count 4026531840"},
+               {"scan-label", laser_rec, "field=\"sensorLabel (length 3758096384)"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = dir + "/" + c.name + ".rawlog";
+    std::ofstream(path, std::ios::binary) << odo << odo << c.record << odo;
+
+    testing::internal::CaptureStderr();
+    const auto t0 = std::chrono::steady_clock::now();
+    RawlogReader rd(path);
+    RawlogEntry e;
+    int n = 0;
+    while (rd.next(e, false)) {
+      EXPECT_EQ(e.kind, RawlogEntry::Kind::Odometry);
+      ++n;
+    }
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(n, 2) << "the records before the corrupt one, and none after it";
+    EXPECT_EQ(rd.truncated(), 1u);
+    EXPECT_NE(err.find("log ends at a corrupt record file=" + path + " record=3 " + c.field),
+              std::string::npos)
+        << err;
+    EXPECT_LT(took, 1.0) << "gigabytes were allocated and filled";
+
+#ifndef __SANITIZE_ADDRESS__  // ASan reserves terabytes of address space up front
+    // The same read with 1 GiB of address space to spare: what the field claims cannot be had.
+    // (MRPT's own reader met bad_alloc here and ended the log without a word.)
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      long pages = 0;
+      std::ifstream("/proc/self/statm") >> pages;
+      const rlim_t limit = static_cast<rlim_t>(pages) * ::sysconf(_SC_PAGESIZE) + (rlim_t{1} << 30);
+      const rlimit lim{limit, limit};
+      ::setrlimit(RLIMIT_AS, &lim);
+      log::setQuiet(true);
+      RawlogReader bounded(path);
+      int m = 0;
+      while (bounded.next(e, false)) ++m;
+      ::_exit(m == 2 && bounded.truncated() == 1 ? 0 : 1);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
+#endif
+  }
 }

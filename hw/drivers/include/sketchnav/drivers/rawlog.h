@@ -59,9 +59,11 @@ struct RawlogEntry {
   double v = 0.0, w = 0.0;  // Kind::Command
 };
 
-/// Sequential reader of a rawlog written by RawlogRecorder (or any MRPT rawlog: unknown
-/// observation types come back as Kind::Other). A truncated tail ends the log quietly
-/// (counted in truncated()).
+/// Sequential reader of a rawlog written by RawlogRecorder. Each record is read into memory
+/// with every length and count in it checked against the bytes there (at most 64 MiB a
+/// record) before MRPT deserialises it. A truncated tail, a corrupt record, or a record of a
+/// class or version the recorder does not write ends the log with a one-line warning naming
+/// the file, the record (counted from 1) and the field (counted in truncated()).
 class RawlogReader {
  public:
   /// Throws InputError naming the file when it cannot be opened.
