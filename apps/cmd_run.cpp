@@ -30,8 +30,12 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
       .option("camera", "camera URI, e.g. aravis://192.168.1.10 or video://0")
       .option("laser", "laser URI")
       .option("sonar", "sonar URI")
-      .option("record", "also write frames, odometry, scans and commands to this MRPT rawlog")
-      .option("replay", "run simulator-free on a recorded rawlog (from --record)");
+      .option("record",
+              "also write frames, odometry, scans and commands to this MRPT rawlog, or to a ROS "
+              "bag when the name ends in .bag")
+      .option("replay",
+              "run simulator-free on a recorded rawlog or ROS bag (from --record, or a bag of ros "
+              "sim's topics)");
   if (!args.parse(argv)) return 0;
   RunOptions o;
   o.world = args.get("world");

@@ -441,7 +441,10 @@ Json runNavigation(const RunOptions& o) {
       sonar = hw::Registry::instance().createRange(world_uri + q + "&sensor=sonar", ctx);
   } else if (replay) {
     if (!fs::exists(o.replay)) throw InputError("--replay " + o.replay + ": no such file");
-    const std::string uri = "rawlog://" + fs::absolute(o.replay).string();
+    // A ROS bag (.bag: camera, odometry, scans as `ros sim` publishes them, or as `run
+    // --record x.bag` writes them) or an MRPT rawlog.
+    const bool bag = fs::path(o.replay).extension() == ".bag";
+    const std::string uri = (bag ? "bag://" : "rawlog://") + fs::absolute(o.replay).string();
     // Simulated time: the log is replayed at its recorded pace on a clock that jumps, so the
     // replay runs as fast as the CPU allows and every device stays in step.
     ctx.clock = std::make_shared<hw::SimClock>();
@@ -449,11 +452,12 @@ Json runNavigation(const RunOptions& o) {
     camera = hw::Registry::instance().createCamera(uri + "?realtime=1", ctx);
     // A log may hold no laser or no sonar scans: that device is then simply absent.
     try {
-      laser = hw::Registry::instance().createRange(uri, ctx);
+      laser = hw::Registry::instance().createRange(uri + (bag ? "?kind=laser" : ""), ctx);
     } catch (const InputError&) {
     }
     try {
-      sonar = hw::Registry::instance().createRange(uri + "?label=SONAR", ctx);
+      sonar =
+          hw::Registry::instance().createRange(uri + (bag ? "?kind=sonar" : "?label=SONAR"), ctx);
     } catch (const InputError&) {
     }
   } else {
@@ -468,8 +472,9 @@ Json runNavigation(const RunOptions& o) {
   if (o.wrap_base && base) base = o.wrap_base(std::move(base));
   if (!camera) throw InputError("--camera URI is required: landmarks are seen by a camera");
   o.config.requireAllUsed();
+  std::shared_ptr<drivers::Recorder> rec;
   if (!o.record.empty()) {
-    auto rec = std::make_shared<drivers::RawlogRecorder>(o.record);
+    rec = drivers::openRecorder(o.record);
     camera = drivers::recordCamera(std::move(camera), rec);
     base = drivers::recordBase(std::move(base), rec, ctx.clock);
     if (laser) laser = drivers::recordRange(std::move(laser), rec, "LASER");
@@ -548,6 +553,30 @@ Json runNavigation(const RunOptions& o) {
     if (!o.config.has("nav.perception.camera_yaw")) pp.camera_yaw = w.camera.yaw;
     if (!o.config.has("nav.perception.camera_pitch")) pp.camera_pitch = w.camera.pitch;
   }
+  if (replay) {
+    // The robot's geometry the recorded run used (RunInfo), unless the user overrides it: a
+    // replay with another camera mount would servo differently on the same frames.
+    const Json info = drivers::readRunInfo(o.replay);
+    const auto take = [&](const char* key, double& v) {
+      if (o.config.has(key) || !info.contains(key)) return;
+      if (!info[key].is_number())
+        throw InputError("--replay " + o.replay + ": run info '" + key + "' is not a number");
+      v = info[key].get<double>();
+    };
+    take("servo.camera_x_m", settings.servo.camera_x_m);
+    take("servo.camera_z_m", settings.servo.camera_z_m);
+    take("nav.avoid.robot_radius_m", settings.avoid.robot_radius_m);
+    take("nav.camera_period_s", settings.exec.camera_period_s);
+    take("nav.perception.camera_yaw", pp.camera_yaw);
+    take("nav.perception.camera_pitch", pp.camera_pitch);
+  }
+  if (rec)
+    rec->addRunInfo({{"servo.camera_x_m", settings.servo.camera_x_m},
+                     {"servo.camera_z_m", settings.servo.camera_z_m},
+                     {"nav.avoid.robot_radius_m", settings.avoid.robot_radius_m},
+                     {"nav.camera_period_s", settings.exec.camera_period_s},
+                     {"nav.perception.camera_yaw", pp.camera_yaw},
+                     {"nav.perception.camera_pitch", pp.camera_pitch}});
   if (o.max_time_s > 0) settings.exec.max_time_s = o.max_time_s;
   settings.exec.validate();
   settings.servo.validate();

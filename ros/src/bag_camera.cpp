@@ -13,8 +13,10 @@
 #include <mutex>
 #include <set>
 
+#include "bag_internal.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/drivers/rawlog.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/ros/bag.h"
 
@@ -26,7 +28,7 @@ const std::string kCompressed = "sensor_msgs/CompressedImage";
 
 class BagCamera final : public hw::Camera {
  public:
-  explicit BagCamera(const Uri& u) : uri_(u.text) {
+  BagCamera(const Uri& u, std::shared_ptr<hw::Clock> clock) : uri_(u.text) {
     const std::string path = u.path;
     if (path.empty() || !std::filesystem::is_regular_file(path))
       throw InputError(u.text + ": no such bag file '" + path + "'");
@@ -60,12 +62,26 @@ class BagCamera final : public hw::Camera {
     const double hfov = u.paramDouble("hfov_deg", 60.0);
     if (!(hfov > 0 && hfov < 180)) throw InputError(u.text + ": hfov_deg must be in (0, 180)");
     hfov_ = hfov * M_PI / 180.0;
-    // The camera_info beside the image topic (".../image_raw" -> ".../camera_info").
+    // The camera_info beside the image topic (".../image_raw" -> ".../camera_info"; an
+    // image_transport topic ".../image_raw/compressed" is beside ".../image_raw").
     std::string info = u.param("info", "");
     if (info.empty()) {
-      const auto slash = topic.rfind('/');
+      std::string image = topic;
+      const std::string suffix = "/compressed";
+      if (image.size() > suffix.size() &&
+          image.compare(image.size() - suffix.size(), suffix.size(), suffix) == 0)
+        image.resize(image.size() - suffix.size());
+      const auto slash = image.rfind('/');
       info =
-          (slash == std::string::npos ? std::string() : topic.substr(0, slash + 1)) + "camera_info";
+          (slash == std::string::npos ? std::string() : image.substr(0, slash + 1)) + "camera_info";
+    }
+    // realtime=1: frames come out at their recorded pace on the run's clock, from the bag's
+    // first stamp, in step with the bag:// base and ranges (run --replay).
+    if (u.paramInt("realtime", 0) != 0 && clock) {
+      clock_ = std::move(clock);
+      const BagOrigin o = bagOrigin(path, *clock_);
+      t0_bag_ = o.t0_bag;
+      t0_clock_ = o.t0_clock;
     }
     rosbag::View iv(bag_, rosbag::TopicQuery(info));
     for (const auto& m : iv) {
@@ -86,8 +102,15 @@ class BagCamera final : public hw::Camera {
     it_ = view_->begin();
   }
 
-  hw::GrabStatus grab(hw::Frame& frame, double) override {
+  hw::GrabStatus grab(hw::Frame& frame, double timeout_s) override {
     std::lock_guard<std::mutex> l(m_);
+    if (held_) {
+      // A frame that was not yet due at the last call.
+      if (!due(held_frame_, timeout_s)) return hw::GrabStatus::Timeout;
+      held_ = false;
+      frame = std::move(held_frame_);
+      return hw::GrabStatus::Ok;
+    }
     while (it_ != view_->end()) {
       // A copy: the iterator's own instance changes when it moves on.
       const rosbag::MessageInstance m = *it_;
@@ -127,11 +150,18 @@ class BagCamera final : public hw::Camera {
         intr_ = hw::Intrinsics::fromFov(img.cols, img.rows, hfov_);
         sized_ = true;
       }
-      frame.image = img;
-      frame.stamp = stamp.toSec() - t0_;
-      frame.seq = ++seq_;
-      frame.source = topic_ + "#" + std::to_string(index_);
+      hw::Frame f;
+      f.image = img;
+      f.stamp = clock_ ? t0_clock_ + (stamp.toSec() - t0_bag_) : stamp.toSec() - t0_;
+      f.seq = ++seq_;
+      f.source = topic_ + "#" + std::to_string(index_);
       ++st_.received;
+      if (!due(f, timeout_s)) {
+        held_frame_ = std::move(f);
+        held_ = true;
+        return hw::GrabStatus::Timeout;
+      }
+      frame = std::move(f);
       return hw::GrabStatus::Ok;
     }
     return hw::GrabStatus::EndOfStream;
@@ -147,6 +177,24 @@ class BagCamera final : public hw::Camera {
   std::string uri() const override { return uri_; }
 
  private:
+  // Paced: waits (a simulated clock jumps) until `f` is due, or `timeout_s` when it is due
+  // later than that (false: the caller gets Timeout and the frame on a later call).
+  // A frame due within drivers::kReplaySlack of now is due now, stamped now (a bag keeps
+  // nanoseconds: 0.44999999999999996 comes back as 0.45).
+  bool due(hw::Frame& f, double timeout_s) {
+    if (!clock_) return true;
+    const double now = clock_->now();
+    if (std::abs(f.stamp - now) <= drivers::kReplaySlack) {
+      f.stamp = now;
+      return true;
+    }
+    if (f.stamp - now > timeout_s) {
+      clock_->sleepUntil(now + timeout_s);
+      return false;
+    }
+    clock_->sleepUntil(f.stamp);
+    return true;
+  }
   mutable std::mutex m_;
   std::string uri_, topic_;
   rosbag::Bag bag_;
@@ -157,6 +205,10 @@ class BagCamera final : public hw::Camera {
   std::uint64_t seq_ = 0, index_ = 0;
   hw::Intrinsics intr_;
   hw::DeviceStats st_;
+  std::shared_ptr<hw::Clock> clock_;  // null: not paced
+  double t0_bag_ = 0, t0_clock_ = 0;
+  bool held_ = false;
+  hw::Frame held_frame_;
 };
 
 }  // namespace
@@ -166,10 +218,11 @@ void registerBagDriver() {
   std::call_once(once, [] {
     hw::Registry::instance().addCamera(
         "bag",
-        [](const Uri& u, hw::DeviceContext&) -> std::unique_ptr<hw::Camera> {
-          return std::make_unique<BagCamera>(u);
+        [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
+          return std::make_unique<BagCamera>(u, ctx.clock);
         },
-        {"topic", "info", "hfov_deg"});
+        {"topic", "info", "hfov_deg", "realtime"});
+    registerBagDevices();
   });
 }
 

@@ -5,14 +5,12 @@
 #include <actionlib/client/simple_action_client.h>
 #include <arpa/inet.h>
 #include <diagnostic_msgs/DiagnosticArray.h>
-#include <geometry_msgs/PoseStamped.h>
-#include <nav_msgs/Path.h>
-#include <sketchnav_msgs/NavigateSketchAction.h>
-#include <visualization_msgs/MarkerArray.h>
 #include <fcntl.h>
+#include <geometry_msgs/PoseStamped.h>
 #include <geometry_msgs/Twist.h>
 #include <gtest/gtest.h>
 #include <nav_msgs/Odometry.h>
+#include <nav_msgs/Path.h>
 #include <netinet/in.h>
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
@@ -20,11 +18,13 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <signal.h>
+#include <sketchnav_msgs/NavigateSketchAction.h>
 #include <std_msgs/String.h>
-#include <tf2_msgs/TFMessage.h>
 #include <sys/socket.h>
 #include <sys/wait.h>
+#include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
+#include <visualization_msgs/MarkerArray.h>
 
 #include <algorithm>
 #include <atomic>
@@ -48,6 +48,8 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
+#include "sketchnav/drivers/recording.h"
+#include "sketchnav/hw/clock.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/ros/bag.h"
 
@@ -554,28 +556,26 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
 
 INSTANTIATE_TEST_SUITE_P(
     Topics, RosGarbage,
-    ::testing::Values(Garbage{"empty_image", "camera on /image_raw: empty image"},
-                      Garbage{"wrong_encoding", "encoding '32FC1'"},
-                      Garbage{"nan_odometry", "odometry on /odom: NaN"},
-                      Garbage{"inf_twist", "odometry on /odom: NaN or Inf in pose or twist"},
-                      Garbage{"zero_quaternion_odometry",
-                              "odometry on /odom: orientation is a zero quaternion"},
-                      // The one pose rule (poseFault) on the tf odometry source too.
-                      Garbage{"nan_tf_odometry",
-                              "odometry (tf odom -> base_link): NaN or Inf in the transform",
-                              nullptr, true},
-                      Garbage{"zero_quaternion_tf",
-                              "odometry (tf odom -> base_link): rotation is a zero quaternion",
-                              nullptr, true},
-                      Garbage{"scan_wrong_length", "the scan has 50 ranges"},
-                      // tf2 refuses the NaN mount (nothing to look up): scans skipped, then
-                      // the range supervisor's stop; a NaN that got through: mountOf's own.
-                      Garbage{"nan_laser_mount", "no tf for the laser frame yet",
-                              "the sensor mount is not finite"},
-                      Garbage{"frozen_camera", "camera on /image_raw: no message for",
-                              // the executive's own check on ROS time, same 0.5 s limit
-                              "safety stop: camera stale: no data for"},
-                      Garbage{"sigint", "SIGINT received"}),
+    ::testing::Values(
+        Garbage{"empty_image", "camera on /image_raw: empty image"},
+        Garbage{"wrong_encoding", "encoding '32FC1'"},
+        Garbage{"nan_odometry", "odometry on /odom: NaN"},
+        Garbage{"inf_twist", "odometry on /odom: NaN or Inf in pose or twist"},
+        Garbage{"zero_quaternion_odometry", "odometry on /odom: orientation is a zero quaternion"},
+        // The one pose rule (poseFault) on the tf odometry source too.
+        Garbage{"nan_tf_odometry", "odometry (tf odom -> base_link): NaN or Inf in the transform",
+                nullptr, true},
+        Garbage{"zero_quaternion_tf",
+                "odometry (tf odom -> base_link): rotation is a zero quaternion", nullptr, true},
+        Garbage{"scan_wrong_length", "the scan has 50 ranges"},
+        // tf2 refuses the NaN mount (nothing to look up): scans skipped, then
+        // the range supervisor's stop; a NaN that got through: mountOf's own.
+        Garbage{"nan_laser_mount", "no tf for the laser frame yet",
+                "the sensor mount is not finite"},
+        Garbage{"frozen_camera", "camera on /image_raw: no message for",
+                // the executive's own check on ROS time, same 0.5 s limit
+                "safety stop: camera stale: no data for"},
+        Garbage{"sigint", "SIGINT received"}),
     [](const ::testing::TestParamInfo<Garbage>& i) { return std::string(i.param.name); });
 
 TEST(RosCli, UnknownRosParameterIsRefused) {
@@ -735,13 +735,109 @@ TEST(RosBag, CameraReadsImagesFromABag) {
   EXPECT_EQ(cam->stats().dropped, 1u);  // the truncated one
   EXPECT_EQ(cam->stats().received, 3u);
   EXPECT_EQ(cam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
-  // A compressed image topic; no camera_info beside it: intrinsics from the 60 deg default.
+  // A compressed image topic (image_transport's .../image_raw/compressed): its camera_info is
+  // the one beside .../image_raw.
   auto jcam = reg.createCamera("bag://" + file + "?topic=/cam/image_raw/compressed", ctx);
   ASSERT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::Ok);
   EXPECT_EQ(f.image.cols, 32);
   EXPECT_NEAR(f.image.at<cv::Vec3b>(5, 5)[0], 50, 3);
-  EXPECT_NEAR(jcam->intrinsics().fx, 16 / std::tan(M_PI / 6), 0.1);
+  EXPECT_DOUBLE_EQ(jcam->intrinsics().fx, 30);
   EXPECT_EQ(jcam->grab(f, 0.1), sketchnav::hw::GrabStatus::EndOfStream);
+  // Without camera_info: intrinsics from the 60 deg default.
+  auto dcam =
+      reg.createCamera("bag://" + file + "?topic=/cam/image_raw/compressed&info=/cam/none", ctx);
+  ASSERT_EQ(dcam->grab(f, 0.1), sketchnav::hw::GrabStatus::Ok);
+  EXPECT_NEAR(dcam->intrinsics().fx, 16 / std::tan(M_PI / 6), 0.1);
+  fs::remove_all(dir);
+}
+
+// `run --record x.bag` / `run --replay x.bag` below the CLI: what the recorder writes, the bag://
+// base and ranges read back on a simulated clock at the recorded times, with the mounts from
+// tf_static and the run info.
+TEST(RosBag, RecordedRunReplaysOnItsOwnTimes) {
+  namespace hw = sketchnav::hw;
+  const std::string dir = "/tmp/sketchnav-test-ros-bagrun-" + std::to_string(getpid());
+  fs::remove_all(dir);
+  fs::create_directories(dir);
+  const std::string file = dir + "/run.bag";
+  sketchnav::ros::registerBagDriver();
+  {
+    auto rec = sketchnav::drivers::openRecorder(file);
+    rec->addRunInfo({{"servo.camera_x_m", 0.1}, {"nav.perception.camera_pitch", 0.2}});
+    for (int k = 0; k <= 4; ++k) {
+      const double t = 0.05 * k;
+      hw::Odometry o;
+      o.pose = {0.1 * k, 0.0, 0.01 * k};
+      o.v = 0.3;
+      o.stamp = t;
+      rec->addOdometry(o);
+      rec->addOdometry(o);  // read twice in one tick: written once
+      hw::RangeScan laser;
+      laser.angles = {-0.5f, 0.0f, 0.5f};
+      laser.ranges = {1.0f, static_cast<float>(2.0 + k), 30.0f};  // 30 = max: nothing seen
+      laser.min_range = 0.1f;
+      laser.max_range = 30.0f;
+      laser.mount = {0.12, 0.0, 0.0};
+      laser.stamp = t;
+      rec->addRange(laser, "LASER");
+      hw::RangeScan sonar;
+      sonar.kind = hw::RangeScan::Kind::Sonar;
+      sonar.angles = {0.0f, 1.57f};
+      sonar.ranges = {0.8f, 3.0f};
+      sonar.min_range = 0.02f;
+      sonar.max_range = 3.0f;
+      sonar.beam_width = 0.4f;
+      sonar.stamp = t;
+      rec->addRange(sonar, "SONAR");
+      rec->addCommand(0.3, 0.1 * k, t, false);
+    }
+  }
+  const auto info = sketchnav::drivers::readRunInfo(file);
+  EXPECT_DOUBLE_EQ(info.value("servo.camera_x_m", 0.0), 0.1);
+
+  auto& reg = hw::Registry::instance();
+  hw::DeviceContext ctx;
+  auto clock = std::make_shared<hw::SimClock>();
+  ctx.clock = clock;
+  auto base = reg.createBase("bag://" + file, ctx);
+  auto laser = reg.createRange("bag://" + file + "?kind=laser", ctx);
+  auto sonar = reg.createRange("bag://" + file + "?kind=sonar", ctx);
+  hw::Odometry o;
+  hw::RangeScan sc;
+  // A recording of a run keeps the run's times: at t the devices show what the run saw at t.
+  for (int k = 0; k <= 4; ++k) {
+    clock->sleepUntil(0.05 * k);
+    ASSERT_TRUE(base->odometry(o)) << "tick " << k;
+    EXPECT_NEAR(o.pose.x, 0.1 * k, 1e-12);
+    EXPECT_NEAR(o.pose.theta, 0.01 * k, 1e-9);
+    EXPECT_NEAR(o.stamp, 0.05 * k, 1e-6);
+    ASSERT_TRUE(laser->read(sc));
+    ASSERT_EQ(sc.ranges.size(), 3u);
+    EXPECT_FLOAT_EQ(sc.ranges[1], 2.0f + k);
+    EXPECT_FLOAT_EQ(sc.ranges[2], 30.0f);
+    EXPECT_NEAR(sc.angles[0], -0.5, 1e-6);
+    EXPECT_NEAR(sc.mount.x, 0.12, 1e-9);
+    ASSERT_TRUE(sonar->read(sc));
+    ASSERT_EQ(sc.ranges.size(), 2u);
+    EXPECT_EQ(sc.kind, hw::RangeScan::Kind::Sonar);
+    EXPECT_NEAR(sc.angles[1], 1.57, 1e-6);
+    EXPECT_FLOAT_EQ(sc.ranges[0], 0.8f);
+    EXPECT_FLOAT_EQ(sc.ranges[1], 3.0f);
+    EXPECT_FLOAT_EQ(sc.beam_width, 0.4f);
+    // As RawlogBase: the link is up until the last record has been replayed.
+    EXPECT_EQ(base->ok(), k < 4) << "tick " << k;
+  }
+
+  EXPECT_THROW(reg.createRange("bag://" + file + "?kind=radar", ctx), sketchnav::InputError);
+  try {
+    reg.createBase("bag://" + file + "?topic=/wheels", ctx);
+    FAIL() << "a base on a topic the bag does not have";
+  } catch (const sketchnav::InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("no nav_msgs/Odometry topic '/wheels'"), std::string::npos)
+        << e.what();
+  }
+  EXPECT_THROW(sketchnav::drivers::openRecorder("/nonexistent-sketchnav/x.bag"),
+               sketchnav::InputError);
   fs::remove_all(dir);
 }
 
@@ -786,13 +882,13 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
         std::lock_guard<std::mutex> l(seen.m);
         ++seen.poses;
       });
-  auto path_sub = nh_->subscribe<nav_msgs::Path>(
-      "/sketchnav_nav/route", 10, [&](const nav_msgs::PathConstPtr& p) {
-        std::lock_guard<std::mutex> l(seen.m);
-        ++seen.paths;
-        seen.path_points = p->poses.size();
-        seen.path_frame = p->header.frame_id;
-      });
+  auto path_sub = nh_->subscribe<nav_msgs::Path>("/sketchnav_nav/route", 10,
+                                                 [&](const nav_msgs::PathConstPtr& p) {
+                                                   std::lock_guard<std::mutex> l(seen.m);
+                                                   ++seen.paths;
+                                                   seen.path_points = p->poses.size();
+                                                   seen.path_frame = p->header.frame_id;
+                                                 });
   auto mark_sub = nh_->subscribe<visualization_msgs::MarkerArray>(
       "/sketchnav_nav/landmarks", 10, [&](const visualization_msgs::MarkerArrayConstPtr& a) {
         std::lock_guard<std::mutex> l(seen.m);
@@ -801,16 +897,17 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
         for (const auto& mk : a->markers)
           if (mk.type == visualization_msgs::Marker::CYLINDER) ++seen.landmark_markers;
       });
-  auto image_sub = nh_->subscribe<sensor_msgs::Image>(
-      "/sketchnav_nav/image", 2, [&](const sensor_msgs::ImageConstPtr& im) {
-        std::lock_guard<std::mutex> l(seen.m);
-        if (im->width > 0 && im->encoding == "bgr8") ++seen.images;
-      });
-  auto result_sub = nh_->subscribe<std_msgs::String>(
-      "/sketchnav_nav/result", 2, [&](const std_msgs::StringConstPtr& s) {
-        std::lock_guard<std::mutex> l(seen.m);
-        seen.last_result = s->data;
-      });
+  auto image_sub = nh_->subscribe<sensor_msgs::Image>("/sketchnav_nav/image", 2,
+                                                      [&](const sensor_msgs::ImageConstPtr& im) {
+                                                        std::lock_guard<std::mutex> l(seen.m);
+                                                        if (im->width > 0 && im->encoding == "bgr8")
+                                                          ++seen.images;
+                                                      });
+  auto result_sub = nh_->subscribe<std_msgs::String>("/sketchnav_nav/result", 2,
+                                                     [&](const std_msgs::StringConstPtr& s) {
+                                                       std::lock_guard<std::mutex> l(seen.m);
+                                                       seen.last_result = s->data;
+                                                     });
   // The node without --sketch: it waits for goals.
   nav_ = std::make_unique<Process>(
       cmd({"ros", "nav", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR, "--max-time", "60"}),
@@ -825,12 +922,11 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
   std::vector<sketchnav_msgs::NavigateSketchFeedback> fb;
   sketchnav_msgs::NavigateSketchGoal goal;
   goal.sketch = sketch;
-  client.sendGoal(
-      goal, RouteClient::SimpleDoneCallback(), RouteClient::SimpleActiveCallback(),
-      [&](const sketchnav_msgs::NavigateSketchFeedbackConstPtr& f) {
-        std::lock_guard<std::mutex> l(fm);
-        fb.push_back(*f);
-      });
+  client.sendGoal(goal, RouteClient::SimpleDoneCallback(), RouteClient::SimpleActiveCallback(),
+                  [&](const sketchnav_msgs::NavigateSketchFeedbackConstPtr& f) {
+                    std::lock_guard<std::mutex> l(fm);
+                    fb.push_back(*f);
+                  });
   ASSERT_TRUE(client.waitForResult(ros::Duration(240))) << logs();
   EXPECT_EQ(client.getState(), actionlib::SimpleClientGoalState::SUCCEEDED)
       << client.getState().toString() << " " << client.getState().getText() << logs();
@@ -843,7 +939,8 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
   const Json rs = Json::parse(res->summary_json);
   EXPECT_TRUE(rs["success"].get<bool>());
   EXPECT_EQ(rs["ros"]["goal_from"], "action");
-  std::printf("latency through ROS, simulated lab frames: %s\n", rs["ros"]["latency"].dump().c_str());
+  std::printf("latency through ROS, simulated lab frames: %s\n",
+              rs["ros"]["latency"].dump().c_str());
   {
     std::lock_guard<std::mutex> l(fm);
     ASSERT_GT(fb.size(), 20u);
@@ -942,8 +1039,7 @@ TEST_F(RosTest, OdometryFromTfDrivesTheShortLabRoute) {
                                         "--rate", "1", "odom:=odom_hidden"}),
                                    (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
   ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20)) << logs();
-  startNav(sketch, {"--max-time", "60", "--set", "ros.odom_source=tf", "--set",
-                    "ros.wait_s=20"});
+  startNav(sketch, {"--max-time", "60", "--set", "ros.odom_source=tf", "--set", "ros.wait_s=20"});
   ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
   EXPECT_EQ(nav_->exitCode(), 0) << logs();
   const Json r = Json::parse(nav_->out());
@@ -1003,8 +1099,8 @@ TEST(RosLaunch, LaunchFilesParse) {
   // roslaunch's command line agrees.
   if (std::system("command -v roslaunch >/dev/null 2>&1") == 0) {
     const std::string c = "ROS_HOME=" + dir.string() + " ROS_PACKAGE_PATH=" + pkg +
-                          " roslaunch --nodes " + SKETCHNAV_ROS_LAUNCH_DIR +
-                          "/sim_nav.launch > " + (dir / "nodes.txt").string() + " 2>&1";
+                          " roslaunch --nodes " + SKETCHNAV_ROS_LAUNCH_DIR + "/sim_nav.launch > " +
+                          (dir / "nodes.txt").string() + " 2>&1";
     EXPECT_EQ(std::system(c.c_str()), 0) << slurp((dir / "nodes.txt").string());
     const std::string n = slurp((dir / "nodes.txt").string());
     EXPECT_NE(n.find("/sketchnav_sim"), std::string::npos) << n;
@@ -1055,8 +1151,8 @@ TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   });
-  startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set", "ros.scan_topic=",
-                                  "--set", "ros.camera_mount_from_tf=false", "--max-time", "60"});
+  startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set", "ros.scan_topic=", "--set",
+                                  "ros.camera_mount_from_tf=false", "--max-time", "60"});
   const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
   if (started && nav_->running()) std::this_thread::sleep_for(std::chrono::seconds(8));
   nav_->signal(SIGINT);
@@ -1094,11 +1190,11 @@ TEST_F(RosTest, AfterAFaultNothingMovesUntilANewGoal) {
   auto start_pub = nh_->advertise<std_msgs::String>("/sketchnav_nav/start", 1, true);
   std::string last_result;
   std::mutex rm;
-  auto result_sub = nh_->subscribe<std_msgs::String>(
-      "/sketchnav_nav/result", 2, [&](const std_msgs::StringConstPtr& s) {
-        std::lock_guard<std::mutex> l(rm);
-        last_result = s->data;
-      });
+  auto result_sub = nh_->subscribe<std_msgs::String>("/sketchnav_nav/result", 2,
+                                                     [&](const std_msgs::StringConstPtr& s) {
+                                                       std::lock_guard<std::mutex> l(rm);
+                                                       last_result = s->data;
+                                                     });
   std::atomic<bool> stop{false}, nan_once{false};
   std::thread robot([&] {
     while (!stop) {

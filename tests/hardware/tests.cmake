@@ -30,3 +30,19 @@ add_test(NAME run_record_replay
           -DCACHE=${PROJECT_BINARY_DIR}/model-cache
           -P ${CMAKE_CURRENT_LIST_DIR}/record_replay.cmake)
 set_tests_properties(run_record_replay PROPERTIES TIMEOUT 300 LABELS "hardware;integration")
+
+# The replay gives the recorded run's commands, tick for tick, from a ROS bag (when sketchnav is
+# built with ROS) and from a rawlog.
+set(_record_formats rawlog)
+if(TARGET sketchnav::ros)
+  list(APPEND _record_formats bag)
+endif()
+foreach(ext IN LISTS _record_formats)
+  add_test(NAME run_replay_same_commands_${ext}
+    COMMAND ${CMAKE_COMMAND} -DSN=$<TARGET_FILE:sketchnav> -DSRC=${PROJECT_SOURCE_DIR}
+            -DWORK=${CMAKE_CURRENT_BINARY_DIR}/replay-same-${ext} -DEXT=${ext}
+            -DCACHE=${PROJECT_BINARY_DIR}/model-cache
+            -P ${CMAKE_CURRENT_LIST_DIR}/record_replay_same.cmake)
+  set_tests_properties(run_replay_same_commands_${ext} PROPERTIES TIMEOUT 300
+                       LABELS "hardware;integration")
+endforeach()

@@ -23,6 +23,7 @@
 #include "laser_convert.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/drivers/rawlog.h"
 
 namespace sketchnav::drivers {
 
@@ -157,9 +158,12 @@ RawlogRangeSensor::RawlogRangeSensor(const std::string& path, bool realtime, boo
     throw InputError("range URI '" + uri_ + "': '" + path + "' holds no 2-D laser scan" +
                      std::string(s.label.empty() ? "" : " or sonar") +
                      (s.label.empty() ? std::string() : " labelled '" + s.label + "'"));
-  s.t0_rec = std::isnan(s.first_any) ? s.queue.front().first
-                                     : std::min(s.first_any, s.queue.front().first);
-  s.t0_clock = s.clock->now();
+  const ReplayOrigin o =
+      replayOrigin(std::isnan(s.first_any) ? s.queue.front().first
+                                           : std::min(s.first_any, s.queue.front().first),
+                   *s.clock, rawlogHasRunInfo(path));
+  s.t0_rec = o.t0_rec;
+  s.t0_clock = o.t0_clock;
 }
 
 RawlogRangeSensor::~RawlogRangeSensor() = default;
@@ -185,19 +189,21 @@ bool RawlogRangeSensor::read(RangeScan& out) {
     // Deliver the newest scan that is due; scans a slow reader missed count as dropped,
     // as they would with a live device.
     const double due = s.t0_clock + (s.queue.front().first - s.t0_rec);
-    if (due > now) return false;
+    if (due > now + kReplaySlack) return false;
     while (true) {
       s.fill(2);
       if (s.queue.size() < 2) break;
       const double next_due = s.t0_clock + (s.queue[1].first - s.t0_rec);
-      if (next_due > now) break;
+      if (next_due > now + kReplaySlack) break;
       s.queue.pop_front();
       ++s.stats.dropped;
     }
   }
+  // Stamped when it was due on the replay clock (when the run scanned), not when it is read.
+  const double due = s.t0_clock + (s.queue.front().first - s.t0_rec);
   out = std::move(s.queue.front().second);
   s.queue.pop_front();
-  out.stamp = now;
+  out.stamp = s.realtime ? std::min(due, now) : now;
   ++s.stats.received;
   return true;
 }

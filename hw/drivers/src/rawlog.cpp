@@ -326,6 +326,16 @@ bool RawlogReader::next(RawlogEntry& out, bool load_images) {
 
 // ---------------------------------------------------------------------------------------
 
+ReplayOrigin replayOrigin(double first_stamp, const Clock& clock, bool run_clock) {
+  if (run_clock) return {};
+  return {std::isfinite(first_stamp) ? first_stamp : 0.0, clock.now()};
+}
+
+bool rawlogHasRunInfo(const std::string& path) {
+  std::error_code ec;
+  return std::filesystem::is_regular_file(path + ".run.json", ec);
+}
+
 double rawlogFirstStamp(const std::string& path) {
   RawlogReader r(path);
   RawlogEntry e;
@@ -339,8 +349,9 @@ RawlogCamera::RawlogCamera(const std::string& path, std::string label, std::stri
       uri_(uri.empty() ? "rawlog://" + path : uri),
       clock_(std::move(clock)) {
   if (clock_) {
-    t0_rec_ = rawlogFirstStamp(path);
-    t0_clock_ = clock_->now();
+    const ReplayOrigin o = replayOrigin(rawlogFirstStamp(path), *clock_, rawlogHasRunInfo(path));
+    t0_rec_ = o.t0_rec;
+    t0_clock_ = o.t0_clock;
   }
   // Read ahead to the first frame so intrinsics() is right before the first grab().
   RawlogEntry e;
@@ -377,15 +388,18 @@ GrabStatus RawlogCamera::grab(Frame& frame, double timeout_s) {
     if (clock_) {
       // Wait (or, on a simulated clock, jump) until the frame is due; a caller that will not
       // wait that long gets Timeout and the frame on the next call.
-      const double due = t0_clock_ + (e.stamp - t0_rec_);
-      if (due - clock_->now() > timeout_s) {
-        clock_->sleepUntil(clock_->now() + timeout_s);
+      const double due = t0_clock_ + (e.stamp - t0_rec_), now = clock_->now();
+      if (std::abs(due - now) <= kReplaySlack) {
+        e.frame.stamp = now;
+      } else if (due - now > timeout_s) {
+        clock_->sleepUntil(now + timeout_s);
         first_ = std::move(e);
         have_first_ = true;
         return GrabStatus::Timeout;
+      } else {
+        clock_->sleepUntil(due);
+        e.frame.stamp = due;
       }
-      clock_->sleepUntil(due);
-      e.frame.stamp = due;
     }
     frame = std::move(e.frame);
     frame.seq = stats_.received++;
@@ -404,8 +418,9 @@ RawlogBase::RawlogBase(const std::string& path, std::shared_ptr<Clock> clock, st
   if (!fetch())
     throw InputError("base URI '" + uri_ + "': '" + path + "' holds no odometry labelled '" +
                      label_ + "'");
-  t0_rec_ = rawlogFirstStamp(path);
-  t0_clock_ = clock_->now();
+  const ReplayOrigin o = replayOrigin(rawlogFirstStamp(path), *clock_, rawlogHasRunInfo(path));
+  t0_rec_ = o.t0_rec;
+  t0_clock_ = o.t0_clock;
 }
 
 RawlogBase::~RawlogBase() = default;
@@ -432,7 +447,7 @@ bool RawlogBase::odometry(Odometry& out) {
   // Move to the newest record that is due on the replay clock.
   // (1 us of slack: MRPT stores times in 100 ns ticks, so a record stamped exactly on a tick
   // of the replay clock must not wait for the next one.)
-  while (have_next_ && t0_clock_ + (next_.stamp - t0_rec_) <= now + 1e-6) {
+  while (have_next_ && t0_clock_ + (next_.stamp - t0_rec_) <= now + kReplaySlack) {
     current_ = next_;
     current_.stamp = t0_clock_ + (next_.stamp - t0_rec_);
     have_current_ = true;

@@ -1,18 +1,58 @@
 #include "sketchnav/drivers/recording.h"
 
 #include <atomic>
+#include <filesystem>
+#include <fstream>
+#include <map>
+#include <mutex>
 
+#include "sketchnav/core/error.h"
+#include "sketchnav/core/json_io.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/hw/forwarding.h"
 
 namespace sketchnav::drivers {
 namespace {
 
+class RawlogSink final : public Recorder {
+ public:
+  explicit RawlogSink(std::shared_ptr<RawlogRecorder> r) : r_(std::move(r)) {}
+  void addFrame(const Frame& frame, const Intrinsics& k) override { r_->addFrame(frame, k); }
+  void addOdometry(const Odometry& odo) override { r_->addOdometry(odo); }
+  void addRange(const RangeScan& scan, const std::string& label) override {
+    r_->addRange(scan, label);
+  }
+  void addCommand(double v, double w, double stamp, bool stop) override {
+    r_->addCommand(v, w, stamp, stop ? "CMD_STOP" : "CMD_VEL");
+  }
+  // Beside the log, as its images are: MRPT's observation types have no place for it.
+  void addRunInfo(const Json& settings) override {
+    const std::string p = r_->path() + ".run.json";
+    std::ofstream out(p, std::ios::trunc);
+    out << settings.dump(1) << "\n";
+    if (!out.flush()) throw RuntimeError(p + ": cannot be written");
+  }
+  std::string path() const override { return r_->path(); }
+
+ private:
+  std::shared_ptr<RawlogRecorder> r_;
+};
+
+struct Recorders {
+  std::mutex m;
+  std::map<std::string, RecorderFactory> by_extension;
+  std::map<std::string, RunInfoReader> info_by_extension;
+};
+Recorders& recorders() {
+  static Recorders r;
+  return r;
+}
+
 // Shared by the three decorators: the first write error turns recording off (logged once), so a
 // full disk costs the log, not the run.
 class Sink {
  public:
-  explicit Sink(std::shared_ptr<RawlogRecorder> r) : rec_(std::move(r)) {}
+  explicit Sink(std::shared_ptr<Recorder> r) : rec_(std::move(r)) {}
   template <class F>
   void write(F&& f) {
     if (failed_) return;
@@ -25,18 +65,18 @@ class Sink {
   }
 
  private:
-  std::shared_ptr<RawlogRecorder> rec_;
+  std::shared_ptr<Recorder> rec_;
   std::atomic<bool> failed_{false};
 };
 
 class RecordingCamera final : public hw::ForwardingCamera {
  public:
-  RecordingCamera(std::unique_ptr<Camera> inner, std::shared_ptr<RawlogRecorder> r)
+  RecordingCamera(std::unique_ptr<Camera> inner, std::shared_ptr<Recorder> r)
       : ForwardingCamera(std::move(inner)), sink_(std::move(r)) {}
   GrabStatus grab(Frame& frame, double timeout_s) override {
     const GrabStatus st = inner().grab(frame, timeout_s);
     if (st == GrabStatus::Ok)
-      sink_.write([&](RawlogRecorder& r) { r.addFrame(frame, inner().intrinsics()); });
+      sink_.write([&](Recorder& r) { r.addFrame(frame, inner().intrinsics()); });
     return st;
   }
 
@@ -46,22 +86,22 @@ class RecordingCamera final : public hw::ForwardingCamera {
 
 class RecordingBase final : public hw::ForwardingBase {
  public:
-  RecordingBase(std::unique_ptr<Base> inner, std::shared_ptr<RawlogRecorder> r,
+  RecordingBase(std::unique_ptr<Base> inner, std::shared_ptr<Recorder> r,
                 std::shared_ptr<Clock> clock)
       : ForwardingBase(std::move(inner)), sink_(std::move(r)), clock_(std::move(clock)) {}
   void command(double v, double w) override {
     inner().command(v, w);
     const double t = clock_ ? clock_->now() : 0.0;
-    sink_.write([&](RawlogRecorder& r) { r.addCommand(v, w, t); });
+    sink_.write([&](Recorder& r) { r.addCommand(v, w, t, false); });
   }
   void stop() noexcept override {
     inner().stop();
     const double t = clock_ ? clock_->now() : 0.0;
-    sink_.write([&](RawlogRecorder& r) { r.addCommand(0.0, 0.0, t, "CMD_STOP"); });
+    sink_.write([&](Recorder& r) { r.addCommand(0.0, 0.0, t, true); });
   }
   bool odometry(Odometry& out) override {
     if (!inner().odometry(out)) return false;
-    sink_.write([&](RawlogRecorder& r) { r.addOdometry(out); });
+    sink_.write([&](Recorder& r) { r.addOdometry(out); });
     return true;
   }
 
@@ -72,12 +112,11 @@ class RecordingBase final : public hw::ForwardingBase {
 
 class RecordingRange final : public hw::ForwardingRangeSensor {
  public:
-  RecordingRange(std::unique_ptr<RangeSensor> inner, std::shared_ptr<RawlogRecorder> r,
-                 std::string label)
+  RecordingRange(std::unique_ptr<RangeSensor> inner, std::shared_ptr<Recorder> r, std::string label)
       : ForwardingRangeSensor(std::move(inner)), sink_(std::move(r)), label_(std::move(label)) {}
   bool read(RangeScan& out) override {
     if (!inner().read(out)) return false;
-    sink_.write([&](RawlogRecorder& r) { r.addRange(out, label_); });
+    sink_.write([&](Recorder& r) { r.addRange(out, label_); });
     return true;
   }
 
@@ -88,20 +127,64 @@ class RecordingRange final : public hw::ForwardingRangeSensor {
 
 }  // namespace
 
+std::shared_ptr<Recorder> rawlogRecorder(std::shared_ptr<RawlogRecorder> rawlog) {
+  return std::make_shared<RawlogSink>(std::move(rawlog));
+}
+
+void registerRecorder(const std::string& extension, RecorderFactory factory) {
+  auto& r = recorders();
+  std::lock_guard<std::mutex> l(r.m);
+  r.by_extension[extension] = std::move(factory);
+}
+
+std::shared_ptr<Recorder> openRecorder(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  {
+    auto& r = recorders();
+    std::lock_guard<std::mutex> l(r.m);
+    const auto it = r.by_extension.find(ext);
+    if (it != r.by_extension.end()) return it->second(path);
+  }
+  if (ext == ".bag")
+    throw InputError("--record " + path +
+                     ": this sketchnav was built without ROS, so it cannot write bags "
+                     "(record a .rawlog, or build with the ROS packages: bootstrap.sh)");
+  return rawlogRecorder(std::make_shared<RawlogRecorder>(path));
+}
+
+void registerRunInfoReader(const std::string& extension, RunInfoReader reader) {
+  auto& r = recorders();
+  std::lock_guard<std::mutex> l(r.m);
+  r.info_by_extension[extension] = std::move(reader);
+}
+
+Json readRunInfo(const std::string& path) {
+  const std::string ext = std::filesystem::path(path).extension().string();
+  {
+    auto& r = recorders();
+    std::lock_guard<std::mutex> l(r.m);
+    const auto it = r.info_by_extension.find(ext);
+    if (it != r.info_by_extension.end()) return it->second(path);
+  }
+  const std::string p = path + ".run.json";
+  if (!std::filesystem::exists(p)) return Json::object();
+  Json j = parseJsonFile(p, "run info");
+  if (!j.is_object()) throw InputError("run info '" + p + "': not a JSON object");
+  return j;
+}
+
 std::unique_ptr<Camera> recordCamera(std::unique_ptr<Camera> inner,
-                                     std::shared_ptr<RawlogRecorder> recorder) {
+                                     std::shared_ptr<Recorder> recorder) {
   if (!inner) return inner;
   return std::make_unique<RecordingCamera>(std::move(inner), std::move(recorder));
 }
-std::unique_ptr<Base> recordBase(std::unique_ptr<Base> inner,
-                                 std::shared_ptr<RawlogRecorder> recorder,
+std::unique_ptr<Base> recordBase(std::unique_ptr<Base> inner, std::shared_ptr<Recorder> recorder,
                                  std::shared_ptr<Clock> clock) {
   if (!inner) return inner;
   return std::make_unique<RecordingBase>(std::move(inner), std::move(recorder), std::move(clock));
 }
 std::unique_ptr<RangeSensor> recordRange(std::unique_ptr<RangeSensor> inner,
-                                         std::shared_ptr<RawlogRecorder> recorder,
-                                         std::string label) {
+                                         std::shared_ptr<Recorder> recorder, std::string label) {
   if (!inner) return inner;
   return std::make_unique<RecordingRange>(std::move(inner), std::move(recorder), std::move(label));
 }

@@ -78,6 +78,25 @@ class RawlogReader {
   std::unique_ptr<Impl> impl_;
 };
 
+/// Where a replayed recording's devices start on the replay clock: a record stamped s is due
+/// at t0_clock + (s - t0_rec). A recording `run --record` made (`run_clock`: it holds the run
+/// info, drivers::readRunInfo) is stamped in the run's clock seconds and keeps its times
+/// (t0_rec = t0_clock = 0), so a replay whose clock starts at 0, as the run's did, shows at
+/// time t what the run saw at t, and gives the run's commands. Any other recording (an MRPT
+/// dataset, a robot's bag in epoch time) starts at its first stamp where the clock is now.
+/// Every device of one recording uses the same origin.
+struct ReplayOrigin {
+  double t0_rec = 0, t0_clock = 0;
+};
+ReplayOrigin replayOrigin(double first_stamp, const Clock& clock, bool run_clock);
+/// True when the rawlog `path` was written by `run --record` (its run info is beside it).
+bool rawlogHasRunInfo(const std::string& path);
+/// A record due within this of the replay clock [s] is due now: stamps come back rounded
+/// (MRPT keeps 100 ns ticks, a bag nanoseconds), and a clock jumped forward by that rounding
+/// would put the replay a hair after the run's instants, where a period check that held at the
+/// run's time fails.
+constexpr double kReplaySlack = 1e-6;
+
 /// The stamp of the first record of a rawlog (any kind): the common time origin of the
 /// replayed devices, so a replayed camera, base and laser stay in step. NaN when none.
 double rawlogFirstStamp(const std::string& path);

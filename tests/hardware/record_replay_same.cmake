@@ -1,0 +1,136 @@
+# `run --record FILE` then `run --replay FILE` (FILE: run.${EXT}, a rawlog or a ROS bag) on the
+# integration hall: the replay sees what the run saw when the run saw it, on the recorded robot
+# geometry, so it gives the recorded run's commands, tick for tick: the same mode, turn, section
+# and attended landmark, and v, w within 1e-5 (m/s, rad/s). Not to the last digit: the recorded
+# scans' beam angles are float32 (a LaserScan keeps angle_min and angle_increment), so the
+# laser odometry's fit, and the executive's pose from it, differ from the run's by ~1e-7 m; the
+# odometry columns are not compared. A replay one tick early or late, or on another camera
+# mount, differs by 1e-3 or more from the first servoed tick on.
+cmake_policy(SET CMP0007 NEW)  # empty CSV fields stay list elements
+file(REMOVE_RECURSE ${WORK})
+file(MAKE_DIRECTORY ${WORK})
+set(FIX ${SRC}/tests/integration/fixtures)
+set(REC ${WORK}/run.${EXT})
+execute_process(
+  COMMAND ${SN} --json run --world ${FIX}/hall.world.json --sketch ${FIX}/hall.sketch.json
+          --cache-dir ${CACHE} --max-time 6 --out ${WORK}/rec --record ${REC}
+  RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT EXISTS ${REC})
+  message(FATAL_ERROR "no recording written (exit ${rc}):\n${err}")
+endif()
+string(JSON frames_live GET "${out}" perception frames)
+# The recording is a camera: every frame the run perceived is in it.
+execute_process(COMMAND ${SN} --json probe ${EXT}://${REC} --frames 1000
+                RESULT_VARIABLE rc OUTPUT_VARIABLE pout ERROR_VARIABLE err)
+string(JSON received GET "${pout}" received)
+if(NOT rc EQUAL 0 OR NOT received EQUAL frames_live)
+  message(FATAL_ERROR "probe of the recording: exit ${rc}, ${received} frames of ${frames_live}\n${pout}\n${err}")
+endif()
+execute_process(
+  COMMAND ${SN} --json run --replay ${REC} --sketch ${FIX}/hall.sketch.json
+          --cache-dir ${CACHE} --max-time 6 --out ${WORK}/replay
+  RESULT_VARIABLE rc OUTPUT_VARIABLE rout ERROR_VARIABLE err)
+if(NOT EXISTS ${WORK}/replay/summary.json)
+  message(FATAL_ERROR "replay wrote no summary (exit ${rc}):\n${rout}\n${err}")
+endif()
+string(JSON mode GET "${rout}" mode)
+string(JSON frames_replay GET "${rout}" perception frames)
+string(JSON cam_x GET "${rout}" settings servo camera_x_m)
+string(JSON cam_x_live GET "${out}" settings servo camera_x_m)
+if(NOT mode STREQUAL "replay" OR NOT frames_replay EQUAL frames_live OR NOT cam_x EQUAL cam_x_live)
+  message(FATAL_ERROR "replay: mode ${mode}, ${frames_replay} frames of ${frames_live}, camera "
+                      "x ${cam_x} (run: ${cam_x_live})\n${rout}")
+endif()
+
+# A decimal number ("-0.0998476", "1.2e-05") in units of 1e-7 (truncated): CMake's math() has
+# integers only.
+function(to_units text out_var)
+  if(NOT text MATCHES "^(-?)([0-9]+)(\\.([0-9]*))?([eE]([-+]?[0-9]+))?$")
+    message(FATAL_ERROR "not a number: '${text}'")
+  endif()
+  set(sign "${CMAKE_MATCH_1}")
+  set(digits "${CMAKE_MATCH_2}${CMAKE_MATCH_4}")
+  string(LENGTH "${CMAKE_MATCH_4}" frac)
+  set(exp 0)
+  if(CMAKE_MATCH_6)
+    set(exp ${CMAKE_MATCH_6})
+  endif()
+  # value = digits x 10^(exp - frac); in 1e-7 units: digits x 10^(exp - frac + 7).
+  math(EXPR shift "${exp} - ${frac} + 7")
+  if(shift GREATER_EQUAL 0)
+    string(REPEAT "0" ${shift} zeros)
+    set(digits "${digits}${zeros}")
+  else()
+    math(EXPR cut "-(${shift})")
+    string(LENGTH "${digits}" n)
+    if(cut GREATER_EQUAL n)
+      set(digits 0)
+    else()
+      math(EXPR keep "${n} - ${cut}")
+      string(SUBSTRING "${digits}" 0 ${keep} digits)
+    endif()
+  endif()
+  # Leading zeros off (not by REGEX REPLACE: its "^" matches again after each replacement).
+  string(LENGTH "${digits}" n)
+  while(n GREATER 1 AND digits MATCHES "^0")
+    string(SUBSTRING "${digits}" 1 -1 digits)
+    math(EXPR n "${n} - 1")
+  endwhile()
+  set(${out_var} "${sign}${digits}" PARENT_SCOPE)
+endfunction()
+
+# Tick for tick: t, v_cmd, w_cmd, mode, turn, section, landmark of every telemetry row.
+function(commands file out_var)
+  file(STRINGS ${file} lines)
+  list(POP_FRONT lines header)
+  if(NOT header MATCHES "^t,odom_x,odom_y,odom_theta,true_x,true_y,true_theta,v_cmd,w_cmd,servo_error,mode,turn,section,landmark")
+    message(FATAL_ERROR "${file}: unexpected columns: ${header}")
+  endif()
+  set(rows)
+  foreach(l IN LISTS lines)
+    string(REPLACE "," ";" f "${l}")
+    list(GET f 0 t)
+    list(GET f 7 v)
+    list(GET f 8 w)
+    list(SUBLIST f 10 4 rest)
+    list(JOIN rest " " rest)
+    list(APPEND rows "${t}|${v}|${w}|${rest}")
+  endforeach()
+  set(${out_var} "${rows}" PARENT_SCOPE)
+endfunction()
+commands(${WORK}/rec/telemetry.csv live)
+commands(${WORK}/replay/telemetry.csv again)
+list(LENGTH live n_live)
+list(LENGTH again n_again)
+if(n_live LESS 100 OR NOT n_live EQUAL n_again)
+  message(FATAL_ERROR "telemetry rows: run ${n_live}, replay ${n_again}")
+endif()
+math(EXPR last "${n_live} - 1")
+foreach(i RANGE ${last})
+  list(GET live ${i} a)
+  list(GET again ${i} b)
+  string(REPLACE "|" ";" fa "${a}")
+  string(REPLACE "|" ";" fb "${b}")
+  list(GET fa 0 ta)
+  list(GET fb 0 tb)
+  list(GET fa 3 ra)
+  list(GET fb 3 rb)
+  set(same TRUE)
+  if(NOT ta STREQUAL tb OR NOT ra STREQUAL rb)
+    set(same FALSE)
+  endif()
+  foreach(k 1 2)
+    list(GET fa ${k} xa)
+    list(GET fb ${k} xb)
+    to_units("${xa}" ua)
+    to_units("${xb}" ub)
+    math(EXPR d "${ua} - ${ub}")
+    if(d GREATER 100 OR d LESS -100)  # 1e-5
+      set(same FALSE)
+    endif()
+  endforeach()
+  if(NOT same)
+    message(FATAL_ERROR "the replay's command differs from the run's at row ${i}:\n  run    ${a}\n  replay ${b}")
+  endif()
+endforeach()
+message(STATUS "${n_live} ticks, the same commands")
