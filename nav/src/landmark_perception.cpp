@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <future>
 #include <limits>
 #include <map>
 
@@ -49,6 +50,8 @@ void PerceptionParams::validate() const {
   require(window_margin >= 0 && window_margin <= 1, "nav.perception.window_margin",
           "must be in [0, 1]");
   require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
+  require(threads >= 1 && threads <= 2, "nav.perception.threads",
+          "must be 1 or 2 (the stages that run side by side)");
   track.validate();
   recognition.validate();
   objectness.validate();
@@ -258,6 +261,7 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   const cv::Rect frame_rect(0, 0, img.cols, img.rows);
+  std::vector<cv::Rect> crops;
   for (int i = 0; i < std::min<int>(P.recognise_windows, ranked.size()); ++i) {
     const cv::Rect& w = windows[ranked[i].second];
     // A margin round the window: objectness windows often clip the object's border.
@@ -266,10 +270,27 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
     const cv::Rect crop =
         cv::Rect(w.x - mx, w.y - my, w.width + 2 * mx, w.height + 2 * my) & frame_rect;
     if (crop.width < 8 || crop.height < 8) continue;
-    ++recognised;
-    Detection d;
-    if (examineCrop(model, img, crop, P.window_side, classes, K, P, d)) out.push_back(d);
+    crops.push_back(crop);
   }
+  recognised += static_cast<int>(crops.size());
+  // Each crop is examined on its own (the model is only read), so with two threads the second
+  // half runs beside the first; the detections are kept in rank order either way.
+  std::vector<Detection> found(crops.size());
+  std::vector<char> ok(crops.size(), 0);
+  const auto examine = [&](size_t from, size_t to) {
+    for (size_t i = from; i < to; ++i)
+      ok[i] = examineCrop(model, img, crops[i], P.window_side, classes, K, P, found[i]);
+  };
+  if (P.threads >= 2 && crops.size() >= 2) {
+    const size_t half = (crops.size() + 1) / 2;
+    auto other = std::async(std::launch::async, examine, half, crops.size());
+    examine(0, half);
+    other.get();
+  } else {
+    examine(0, crops.size());
+  }
+  for (size_t i = 0; i < crops.size(); ++i)
+    if (ok[i]) out.push_back(std::move(found[i]));
   return out;
 }
 
@@ -296,17 +317,26 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
   if (frame.image.empty() || classes.empty()) return ob;
   ob.timing.full_pass = true;
 
-  auto t = clk::now();
-  const auto windows = impl_->objectness.propose(frame.image, P.max_windows);
-  ob.timing.objectness_ms = msSince(t);
-  ob.timing.windows = static_cast<int>(windows.size());
+  // The objectness windows and the frame's features do not depend on each other: with two
+  // threads the windows are proposed beside the features.
+  const auto proposeWindows = [&] {
+    const auto t = clk::now();
+    auto w = impl_->objectness.propose(frame.image, P.max_windows);
+    ob.timing.objectness_ms = msSince(t);
+    return w;
+  };
+  std::future<std::vector<landmarks::Window>> proposing;
+  if (P.threads >= 2) proposing = std::async(std::launch::async, proposeWindows);
 
-  t = clk::now();
+  auto t = clk::now();
   landmarks::FeatureParams fp = model.params().features;
   fp.max_image_side = P.frame_max_side;
   fp.max_features = P.frame_max_features;
   const auto feats = landmarks::computeFrameFeatures(model, frame.image, fp);
   ob.timing.features_ms = msSince(t);
+
+  const auto windows = proposing.valid() ? proposing.get() : proposeWindows();
+  ob.timing.windows = static_cast<int>(windows.size());
 
   t = clk::now();
   const landmarks::MatchParams mp = matchParams(P);

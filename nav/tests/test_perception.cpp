@@ -365,6 +365,8 @@ TEST(PerceptionParamsTest, FoveaFieldsAreValidated) {
   bad([](PerceptionParams& p) { p.fovea_min_range_m = -1; }, "fovea_min_range_m");
   bad([](PerceptionParams& p) { p.fovea_max_range_m = 0; }, "fovea_max_range_m");
   bad([](PerceptionParams& p) { p.fovea_max_looks = -1; }, "fovea_max_looks");
+  bad([](PerceptionParams& p) { p.threads = 0; }, "threads");
+  bad([](PerceptionParams& p) { p.threads = 3; }, "threads");
 }
 
 // The recognition stage on a photo the model was not trained on (the catalogue photo; the
@@ -416,6 +418,40 @@ TEST_F(RecognitionStage, FindsAHeldOutViewThatMatchingAloneMisses) {
   EXPECT_GE(found, scenes * 2 / 3) << "of " << scenes;
   EXPECT_GT(found, found_matching_only + scenes / 3);
   EXPECT_EQ(wrong, 0);
+}
+
+// Two threads change when the stages run, not what they find: the same detections (class,
+// window, inliers, column) in the same order as on one thread, scene for scene.
+TEST_F(RecognitionStage, TwoThreadsFindExactlyWhatOneFinds) {
+  int detections = 0;
+  for (const char* cls : {kTarget, kOther}) {
+    const cv::Mat photo = cv::imread(iconic(cls));
+    ASSERT_FALSE(photo.empty());
+    for (const double u : {160.0, 480.0}) {
+      hw::Frame f;
+      f.image = sceneWith(photo, 110, u, 230, 7 + static_cast<unsigned>(u));
+      const auto look = std::vector<std::string>{kTarget, kOther};
+      PerceptionParams p;
+      p.fovea = false;
+      p.threads = 1;
+      const Observation one = LandmarkPerception(model_, p).observe(f, K, look);
+      p.threads = 2;
+      const Observation two = LandmarkPerception(model_, p).observe(f, K, look);
+      ASSERT_EQ(one.detections.size(), two.detections.size()) << cls << " at u=" << u;
+      for (size_t i = 0; i < one.detections.size(); ++i) {
+        const Detection &a = one.detections[i], &b = two.detections[i];
+        EXPECT_EQ(a.class_name, b.class_name);
+        EXPECT_EQ(a.window, b.window);
+        EXPECT_EQ(a.inliers, b.inliers);
+        EXPECT_DOUBLE_EQ(a.x_t, b.x_t);
+        EXPECT_DOUBLE_EQ(a.x_d, b.x_d);
+      }
+      EXPECT_EQ(one.timing.windows, two.timing.windows);
+      EXPECT_EQ(one.timing.recognised, two.timing.recognised);
+      detections += static_cast<int>(one.detections.size());
+    }
+  }
+  EXPECT_GT(detections, 0) << "nothing found: the comparison would be vacuous";
 }
 
 TEST(PerceptionParamsTest, RecognitionFieldsAreValidated) {

@@ -148,7 +148,12 @@ struct PerceptionParams {
   int window_side = 256;          // [px] a recognised window is cropped and scaled to this side
   double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
   int window_max_features = 500;  // strongest keypoints kept in the crop (0 = all)
-  TrackParams track;              // "nav.perception.track.*" (detect, then track)
+  // Threads a full pass uses for its independent stages: the objectness windows beside the
+  // frame's features, and the ranked windows' recognition split between them. 1 = everything on
+  // the calling thread. The detections are the same for any count (only the wall time
+  // changes); evidence: doc/perception-benchmark.md "Two cores".
+  int threads = 2;
+  TrackParams track;                         // "nav.perception.track.*" (detect, then track)
   landmarks::RecognitionParams recognition;  // "landmarks.recognition.*"
   landmarks::ObjectnessParams objectness;    // "objectness.*" (the windows proposed per frame)
   template <class B>
@@ -180,6 +185,7 @@ struct PerceptionParams {
     b("window_side", window_side);
     b("window_margin", window_margin);
     b("window_max_features", window_max_features);
+    b("threads", threads);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
 };
