@@ -50,6 +50,8 @@ void PerceptionParams::validate() const {
   require(window_margin >= 0 && window_margin <= 1, "nav.perception.window_margin",
           "must be in [0, 1]");
   require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
+  require(window_tilts >= 0 && window_tilts <= 4, "nav.perception.window_tilts",
+          "must be in [0, 4] (tilted views per recognised window)");
   require(threads >= 1 && threads <= 2, "nav.perception.threads",
           "must be 1 or 2 (the stages that run side by side)");
   track.validate();
@@ -199,18 +201,18 @@ float bowScore(const landmarks::LandmarkModel& model, const landmarks::FrameFeat
   return best;
 }
 
-// A crop of the full-resolution frame scaled so its longer side is `side` px, recognised on
-// its own features (a landmark a few dozen pixels wide in the frame gets the pixels SIFT needs);
-// when the answer is one of `classes`, matched for its position (min_inliers, else
-// position_min_inliers) and mapped back to frame pixels. False when it gives no detection (not
-// recognised as a looked-for class, or no match to place it).
-bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, const cv::Rect& crop,
-                 int side, const std::vector<std::string>& classes, const hw::Intrinsics& K,
-                 const PerceptionParams& P, Detection& d) {
-  const double scale = static_cast<double>(side) / std::max(crop.width, crop.height);
+// A crop of the full-resolution frame, stretched horizontally by `tilt` (1 = as seen) and scaled
+// so its longer side is `side` px, recognised on its own features (a landmark a few dozen pixels
+// wide in the frame gets the pixels SIFT needs); when the answer is one of `classes`, matched for
+// its position (min_inliers, else position_min_inliers) and mapped back to frame pixels. False
+// when it gives no detection (not recognised as a looked-for class, or no match to place it).
+bool examineView(const landmarks::LandmarkModel& model, const cv::Mat& img, const cv::Rect& crop,
+                 int side, double tilt, const std::vector<std::string>& classes,
+                 const hw::Intrinsics& K, const PerceptionParams& P, Detection& d) {
+  const double scale = static_cast<double>(side) / std::max(tilt * crop.width, 1.0 * crop.height);
   cv::Mat patch;
-  cv::resize(img(crop), patch, cv::Size(), scale, scale,
-             scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
+  cv::resize(img(crop), patch, cv::Size(), tilt * scale, scale,
+             tilt * scale > 1 || scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
   landmarks::FeatureParams fp = model.params().features;
   fp.max_image_side = std::max({64, patch.cols, patch.rows});  // already at the chosen size
   fp.max_features = P.window_max_features;
@@ -227,7 +229,7 @@ bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   }
   bool placed = false;
   if (m.matched) {
-    toFramePixels(m, crop, patch.size());
+    toFramePixels(m, crop, patch.size());  // per axis: undoes the stretch too
     placed = toDetection(m, r.class_name, crop, img.cols, K, P, d);
   }
   // Without geometry there is no position: a window's centre is not the landmark's (a window
@@ -240,6 +242,21 @@ bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   if (d.recognised_only) d.elevation = NAN;
   if (d.confidence <= 0) d.confidence = 0.5f * r.colour_probability;
   return true;
+}
+
+// The crop as seen, then, while nothing is found, its tilted views (window_tilts of them, tilt
+// sqrt(2)^k): a landmark turned by a yaw about the vertical axis is foreshortened horizontally
+// by ~cos(yaw), which SIFT tolerates to ~30 degrees; stretching the crop back by 1/cos (1.41:
+// 45 degrees, 2: 60 degrees) undoes most of it (ASIFT's tilts, applied to the frame instead of
+// the database, so the model stays as it is and views are paid for only where nothing was
+// found).
+bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, const cv::Rect& crop,
+                 int side, const std::vector<std::string>& classes, const hw::Intrinsics& K,
+                 const PerceptionParams& P, Detection& d) {
+  double tilt = 1;
+  for (int k = 0; k <= P.window_tilts; ++k, tilt *= std::sqrt(2.0))
+    if (examineView(model, img, crop, side, tilt, classes, K, P, d)) return true;
+  return false;
 }
 
 // The recognition stage: the `windows` ranked by the looked-for classes' BoW score on the

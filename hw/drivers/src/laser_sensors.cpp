@@ -21,6 +21,7 @@
 #include <thread>
 
 #include "laser_convert.h"
+#include "rawlog_record.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/drivers/rawlog.h"
@@ -65,12 +66,56 @@ struct RawlogRangeSensor::Impl {
   double t0_rec = NAN, t0_clock = 0, last_rec = NAN, first_any = NAN;
   std::uint64_t scans_in_file = 0;
   DeviceStats stats;
+  // A log whose first record is one run --record writes is read record by record with every
+  // length checked before anything is allocated (rawlog_record.h), as RawlogReader does: a
+  // corrupt recording cannot make MRPT allocate what a length field claims. Other logs (MRPT's
+  // own datasets: CSensoryFrame and action records) are read by MRPT, which knows them.
+  bool bounded = false;
+  std::vector<std::uint8_t> bytes;  // the record being read (bounded)
 
   void reopen() {
     file = std::make_unique<mrpt::io::CFileGZInputStream>();
     if (!file->open(path)) throw InputError("rawlog '" + path + "': cannot open");
     eof = false;
     entry = 0;
+  }
+
+  // Whether the log is one of ours, from its first record (the file is reopened after).
+  void chooseReader() {
+    const RawlogRecordRead first = readRawlogRecord(*file, bytes);
+    bounded = first.status != RawlogRecordRead::Status::Foreign;
+    reopen();
+  }
+
+  void stop(const char* message, const std::string& field) {
+    // Like an undecodable entry: the log ends here, everything before it is intact.
+    log::warn("rawlog", message,
+              {{"file", path}, {"record", std::to_string(entry)}, {"field", field}});
+    ++stats.incomplete;
+    eof = true;
+  }
+
+  // One record of a bounded log; false when the log ends (or stops at a bad record).
+  bool nextBounded() {
+    const RawlogRecordRead got = readRawlogRecord(*file, bytes);
+    if (got.status == RawlogRecordRead::Status::End) return false;
+    ++entry;
+    if (got.status == RawlogRecordRead::Status::Incomplete) {
+      stop("log ends with an incomplete record", got.field);
+      return false;
+    }
+    if (got.status != RawlogRecordRead::Status::Ok) {
+      stop("log ends at a corrupt record", got.field);
+      return false;
+    }
+    std::string bad;
+    const mrpt::obs::CObservation::Ptr obs = decodeRawlogRecord(bytes, bad);
+    if (!obs) {
+      stop("log ends at a corrupt record", bad);
+      return false;
+    }
+    take(obs);
+    return true;
   }
 
   void take(const mrpt::obs::CObservation::Ptr& o) {
@@ -115,6 +160,10 @@ struct RawlogRangeSensor::Impl {
   // Decodes entries until `want` scans are queued or the file ends.
   void fill(std::size_t want = 1) {
     while (queue.size() < want && !eof) {
+      if (bounded) {
+        if (!nextBounded()) eof = true;
+        continue;
+      }
       mrpt::obs::CActionCollection::Ptr action;
       mrpt::obs::CSensoryFrame::Ptr sf;
       mrpt::obs::CObservation::Ptr obs;
@@ -153,6 +202,7 @@ RawlogRangeSensor::RawlogRangeSensor(const std::string& path, bool realtime, boo
   s.loop = loop;
   s.clock = clock ? std::move(clock) : std::make_shared<SteadyClock>();
   s.reopen();
+  s.chooseReader();
   s.fill();
   if (s.queue.empty())
     throw InputError("range URI '" + uri_ + "': '" + path + "' holds no 2-D laser scan" +

@@ -198,28 +198,17 @@ struct RawlogReader::Impl {
         end("log ends with an incomplete record", got.field);
         break;
       }
-      if (got.status == RawlogRecordRead::Status::Corrupt) {
+      if (got.status == RawlogRecordRead::Status::Corrupt ||
+          got.status == RawlogRecordRead::Status::Foreign) {
         end("log ends at a corrupt record", got.field);
         break;
       }
-      mrpt::io::CMemoryStream mem;
-      mem.assignMemoryNotOwn(bytes.data(), bytes.size());
-      auto arch = mrpt::serialization::archiveFrom(mem);
-      mrpt::obs::CObservation::Ptr obs;
       std::string bad;
-      try {
-        obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(arch.ReadObject());
-        if (mem.getPosition() != bytes.size()) bad = "record layout (MRPT read a different length)";
-      } catch (const std::exception& e) {
-        const std::string what = e.what();
-        bad =
-            "record layout (MRPT: " + what.substr(0, std::min(what.find('\n'), std::size_t{120})) +
-            ")";
-      }
-      if (bad.empty() && obs) bad = corruptField(*obs);
-      if (!bad.empty() || !obs) {
+      const mrpt::obs::CObservation::Ptr obs = decodeRawlogRecord(bytes, bad);
+      if (obs) bad = corruptField(*obs);
+      if (!bad.empty()) {
         // Like an undecodable record: the log ends here, everything before is intact.
-        end("log ends at a corrupt record", bad.empty() ? "record class" : bad);
+        end("log ends at a corrupt record", bad);
         break;
       }
       pending.push_back(obs);

@@ -1,5 +1,8 @@
 #include "rawlog_record.h"
 
+#include <mrpt/io/CMemoryStream.h>
+#include <mrpt/serialization/CArchive.h>
+
 #include <algorithm>
 #include <climits>
 #include <cstring>
@@ -262,7 +265,7 @@ class Walker {
     else if (name == "mrpt::obs::CObservationImage")
       picture(v);
     else
-      throw Refused{Status::Corrupt, "class " + clip(name) + " (not one run --record writes)"};
+      throw Refused{Status::Foreign, "class " + clip(name) + " (not one run --record writes)"};
     end(name.substr(name.rfind(':') + 1));
     return {Status::Ok, {}};
   }
@@ -292,6 +295,28 @@ RawlogRecordRead readRawlogRecord(mrpt::io::CStream& in, std::vector<std::uint8_
   } catch (const std::exception& e) {
     return {Status::Corrupt, std::string("file read (") + e.what() + ")"};
   }
+}
+
+mrpt::obs::CObservation::Ptr decodeRawlogRecord(const std::vector<std::uint8_t>& bytes,
+                                                std::string& bad) {
+  mrpt::io::CMemoryStream mem;
+  mem.assignMemoryNotOwn(bytes.data(), bytes.size());
+  auto arch = mrpt::serialization::archiveFrom(mem);
+  mrpt::obs::CObservation::Ptr obs;
+  try {
+    obs = std::dynamic_pointer_cast<mrpt::obs::CObservation>(arch.ReadObject());
+    if (mem.getPosition() != bytes.size()) {
+      bad = "record layout (MRPT read a different length)";
+      return nullptr;
+    }
+  } catch (const std::exception& e) {
+    const std::string what = e.what();
+    bad =
+        "record layout (MRPT: " + what.substr(0, std::min(what.find('\n'), std::size_t{120})) + ")";
+    return nullptr;
+  }
+  if (!obs) bad = "record class";
+  return obs;
 }
 
 }  // namespace sketchnav::drivers

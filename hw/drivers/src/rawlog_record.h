@@ -7,6 +7,7 @@
 // that would take the record past `max_bytes`; MRPT then deserialises the record from those
 // bytes alone, so nothing it sizes can exceed the record. Private to hw/drivers.
 #include <mrpt/io/CStream.h>
+#include <mrpt/obs/CObservation.h>
 
 #include <cstddef>
 #include <cstdint>
@@ -24,7 +25,9 @@ struct RawlogRecordRead {
     Ok,          ///< `bytes` holds one whole record
     End,         ///< the file ended between records
     Incomplete,  ///< the file ended inside the record (a cut tail)
-    Corrupt,     ///< a field is impossible or the class/version is not one we write
+    Corrupt,     ///< a field is impossible or a version is not one we write
+    Foreign,     ///< a top-level class run --record does not write (e.g. an MRPT dataset's
+                 ///< CSensoryFrame); nothing past its header was read
   };
   Status status = Status::End;
   std::string field;  ///< Incomplete / Corrupt: the field and what is wrong with it
@@ -35,5 +38,11 @@ struct RawlogRecordRead {
 /// or raw image) from `in` into `bytes`. `bytes` never grows past `max_bytes` plus 64 KiB.
 RawlogRecordRead readRawlogRecord(mrpt::io::CStream& in, std::vector<std::uint8_t>& bytes,
                                   std::size_t max_bytes = kMaxRawlogRecordBytes);
+
+/// The observation in a record readRawlogRecord() returned Ok for, deserialised by MRPT from
+/// `bytes` alone (so nothing it sizes can exceed the record). Null, with `bad` naming what is
+/// wrong, when MRPT fails or consumes another length than the walk did.
+mrpt::obs::CObservation::Ptr decodeRawlogRecord(const std::vector<std::uint8_t>& bytes,
+                                                std::string& bad);
 
 }  // namespace sketchnav::drivers

@@ -17,6 +17,7 @@
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
+#include "sketchnav/drivers/laser_sensors.h"
 #include "sketchnav/drivers/rawlog.h"
 #include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
@@ -308,6 +309,75 @@ TEST(Rawlog, ARecordWhoseLengthFieldClaimsGigabytesEndsTheLogWithoutBeingAllocat
       int m = 0;
       while (bounded.next(e, false)) ++m;
       ::_exit(m == 2 && bounded.truncated() == 1 ? 0 : 1);
+    }
+    int status = 0;
+    ::waitpid(child, &status, 0);
+    EXPECT_TRUE(WIFEXITED(status) && WEXITSTATUS(status) == 0) << "status " << status;
+#endif
+  }
+}
+
+// The same corrupt records replayed as a laser or a sonar (rawlog:// as a range device, which
+// `run --replay` opens): the scans before the bad record come back, the log ends there with
+// the field named, and what the length field claims is never allocated.
+TEST(Rawlog, ARangeReplayOfARecordClaimingGigabytesEndsWithoutAllocatingIt) {
+  const std::string dir = test::tempDir("rawlog-huge-range");
+  RangeScan sonar;
+  sonar.kind = RangeScan::Kind::Sonar;
+  sonar.angles = {0.0f, 0.5f};
+  sonar.ranges = {1.5f, 3.0f};
+  sonar.max_range = 3.0f;
+  const std::string sonar_ok = recordOf(dir, [&](RawlogRecorder& r) { r.addRange(sonar); });
+  const std::string laser_ok = recordOf(dir, [&](RawlogRecorder& r) { r.addRange(makeLaser()); });
+  std::string sonar_bad = sonar_ok, laser_bad = laser_ok;
+  const std::string range_class = "mrpt::obs::CObservationRange";
+  ASSERT_EQ(sonar_bad.substr(1, range_class.size()), range_class);
+  putU32(sonar_bad, 1 + range_class.size() + 1 + 3 * 4, 0xF0000000u);
+  const std::size_t label = laser_bad.rfind("LASER");
+  ASSERT_NE(label, std::string::npos);
+  putU32(laser_bad, label - 4, 0xE0000000u);
+
+  const struct {
+    std::string name, ok, bad, label, field;
+  } cases[] = {{"sonar-count", sonar_ok, sonar_bad, "SONAR", "field=\"sensedData count 4026531840"},
+               {"scan-label", laser_ok, laser_bad, "", "field=\"sensorLabel (length 3758096384)"}};
+  for (const auto& c : cases) {
+    SCOPED_TRACE(c.name);
+    const std::string path = dir + "/" + c.name + ".rawlog";
+    std::ofstream(path, std::ios::binary) << c.ok << c.ok << c.bad << c.ok;
+    const auto readAll = [&](RawlogRangeSensor& r) {
+      RangeScan s;
+      int n = 0;
+      while (r.read(s)) ++n;
+      return n;
+    };
+
+    testing::internal::CaptureStderr();
+    const auto t0 = std::chrono::steady_clock::now();
+    RawlogRangeSensor range(path, /*realtime=*/false, /*loop=*/false, c.label, nullptr);
+    const int n = readAll(range);
+    const double took =
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    const std::string err = testing::internal::GetCapturedStderr();
+    EXPECT_EQ(n, 2) << "the scans before the corrupt record, and none after it";
+    EXPECT_EQ(range.stats().incomplete, 1u);
+    EXPECT_NE(err.find("log ends at a corrupt record file=" + path + " record=3 " + c.field),
+              std::string::npos)
+        << err;
+    EXPECT_LT(took, 1.0) << "gigabytes were allocated and filled";
+
+#ifndef __SANITIZE_ADDRESS__  // ASan reserves terabytes of address space up front
+    const pid_t child = ::fork();
+    ASSERT_GE(child, 0);
+    if (child == 0) {
+      long pages = 0;
+      std::ifstream("/proc/self/statm") >> pages;
+      const rlim_t limit = static_cast<rlim_t>(pages) * ::sysconf(_SC_PAGESIZE) + (rlim_t{1} << 30);
+      const rlimit lim{limit, limit};
+      ::setrlimit(RLIMIT_AS, &lim);
+      log::setQuiet(true);
+      RawlogRangeSensor bounded(path, false, false, c.label, nullptr);
+      ::_exit(readAll(bounded) == 2 && bounded.stats().incomplete == 1 ? 0 : 1);
     }
     int status = 0;
     ::waitpid(child, &status, 0);

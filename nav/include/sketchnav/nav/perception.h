@@ -148,6 +148,13 @@ struct PerceptionParams {
   int window_side = 256;          // [px] a recognised window is cropped and scaled to this side
   double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
   int window_max_features = 500;  // strongest keypoints kept in the crop (0 = all)
+  // Tilted views of a recognised window where the view as seen finds nothing: the crop
+  // stretched horizontally by sqrt(2)^k, k = 1..window_tilts (a landmark turned ~45 and ~60
+  // degrees away, foreshortened by cos(yaw), seen at its face's proportions). Each view costs
+  // one more recognition of the window. 0 = the window as seen only. Off by default: on the
+  // bench's sequences it finds more but also reports a sibling class more often
+  // (doc/perception-benchmark.md, 'Tilted views').
+  int window_tilts = 0;
   // Threads a full pass uses for its independent stages: the objectness windows beside the
   // frame's features, and the ranked windows' recognition split between them. 1 = everything on
   // the calling thread. The detections are the same for any count (only the wall time
@@ -185,6 +192,7 @@ struct PerceptionParams {
     b("window_side", window_side);
     b("window_margin", window_margin);
     b("window_max_features", window_max_features);
+    b("window_tilts", window_tilts);
     b("threads", threads);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
