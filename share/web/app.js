@@ -230,9 +230,11 @@ function renderLandmarks() {
     }
     const order = orderOf(l.id);
     if (order !== null && $('show-route').checked) {
+      // On the box's top-right corner, kept inside the canvas (a box at the edge cut it).
       const b = el('g', { class: 'badge' }, gg);
-      el('circle', { cx: l.x + l.w, cy: l.y, r: 11 }, b);
-      const bt = el('text', { x: l.x + l.w, y: l.y + 4 }, b);
+      const bx = clamp(l.x + l.w, 12, W - 12), by = clamp(l.y, 12, H - 12);
+      el('circle', { cx: bx, cy: by, r: 11 }, b);
+      const bt = el('text', { x: bx, y: by + 4 }, b);
       bt.textContent = String(order + 1);
     }
     if (l.id === selectedId)
@@ -246,14 +248,27 @@ function renderMarks() {
   const s = startPoint(), e = goalPoint();
   if (s) {
     el('circle', { class: 'mark-start', cx: s[0], cy: s[1], r: 14 }, g);
-    const t = el('text', { class: 'mark-label', x: s[0] + 16, y: s[1] + 22, fill: '#1f9d55' }, g);
+    const t = el('text', { class: 'mark-label', fill: '#1f9d55' }, g);
     t.textContent = 'start';
+    placeMarkLabel(t, s);
   }
   if (e) {
     el('circle', { class: 'mark-goal', cx: e[0], cy: e[1], r: 14 }, g);
-    const t = el('text', { class: 'mark-label', x: e[0] + 16, y: e[1] + 22, fill: '#c62828' }, g);
+    const t = el('text', { class: 'mark-label', fill: '#c62828' }, g);
     t.textContent = state.goalDoor === null ? 'goal' : `goal: ${state.goalDoor} m before the door`;
+    placeMarkLabel(t, e);
   }
+}
+
+// A start / goal label below right of its mark, or left of it / above it where that would run
+// off the canvas ("goal: 0.6 m before the door" was cut at the right edge).
+function placeMarkLabel(t, p) {
+  const len = t.getComputedTextLength ? t.getComputedTextLength() : 0;
+  let x = p[0] + 16, y = p[1] + 22;
+  if (x + len > W - 2) x = p[0] - 16 - len;
+  if (y > H - 4) y = p[1] - 18;
+  t.setAttribute('x', clamp(x, 2, Math.max(2, W - 2 - len)));
+  t.setAttribute('y', clamp(y, 14, H - 4));
 }
 
 const deg = (r) => Math.round((r * 180) / Math.PI);
