@@ -710,6 +710,9 @@ function renderBackground() {
       el('rect', { class: 'w-lm', x: c[0] - 5, y: c[1] - 5, width: 10, height: 10 }, gg);
       const t = el('text', { class: 'w-lm-label', x: c[0] + 7, y: c[1] - 6 }, gg);
       t.textContent = `${l.id} ${l.class}`;
+      // inside the canvas when the landmark is near its right edge (the corridor's end wall)
+      const len = t.getComputedTextLength ? t.getComputedTextLength() : 0;
+      if (c[0] + 7 + len > W - 2 && c[0] < W) t.setAttribute('x', Math.max(2, W - 2 - len));
     }
     const st = f([0, 0]), ah = f([0.8, 0]);
     el('line', { class: 'w-start', x1: st[0], y1: st[1], x2: ah[0], y2: ah[1] }, gg);

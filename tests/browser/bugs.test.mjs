@@ -189,17 +189,19 @@ try {
       const sw = await phone.evaluate(() => document.documentElement.scrollWidth);
       assert.ok(sw <= 390, `page ${sw} px wide: no sideways scrolling`);
       // With a world under the sketch its note sits above the canvas, not over it; the zoom
-      // buttons inside the canvas; the palette in columns.
+      // buttons and the scale bar under it, on the screen; the palette in columns.
       await phone.selectOption('#open', 'examples/lab.sketch.json');
       await phone.waitForFunction(() => route !== null);
       await phone.selectOption('#world', 'lab');
       await phone.waitForFunction(() => !document.getElementById('bg-note').hidden && /placed as the robot reads/.test(document.getElementById('bg-note').textContent));
       const c = await phone.locator('#canvas').boundingBox(), n = await phone.locator('#bg-note').boundingBox();
       assert.ok(n.y + n.height <= c.y + 0.5, `note ${JSON.stringify(n)} over the canvas ${JSON.stringify(c)}`);
-      for (const id of ['#zoom-in', '#zoom-out', '#zoom-fit']) {
+      for (const id of ['#zoom-in', '#zoom-out', '#zoom-fit', '#scale-bar']) {
         const z = await phone.locator(id).boundingBox();
-        assert.ok(z.x >= c.x && z.x + z.width <= c.x + c.width && z.y >= c.y && z.y + z.height <= c.y + c.height, `${id} inside the canvas`);
+        assert.ok(z.y >= c.y + c.height - 0.5 && z.x >= 0 && z.x + z.width <= 390, `${id} ${JSON.stringify(z)} under the canvas ${JSON.stringify(c)}, on the screen`);
       }
+      const zi = await phone.locator('#zoom-in').boundingBox(), sb = await phone.locator('#scale-bar').boundingBox();
+      assert.ok(sb.x + sb.width <= zi.x, 'scale bar left of the zoom buttons');
       const tops = await phone.$$eval('.class-card', (cs) => cs.slice(0, 2).map((e) => e.getBoundingClientRect().top));
       assert.equal(tops[0], tops[1], 'palette cards side by side');
       await phone.screenshot({ path: path.join(out, 'bugs-phone.png'), fullPage: true });
@@ -299,8 +301,11 @@ try {
           const set = { w: '-0.35', v: '0.30', section: '12/12', mode: 'succeeded', landmark: 'L12', time: '999.9' };
           const cells = Object.entries(set).map(([id, v]) => { const e = document.getElementById(id); e.textContent = v; return [id, e.scrollWidth, e.clientWidth]; });
           const s = strip.getBoundingClientRect();
-          return { cells, h0, h1: s.height, right: s.right };
+          const rows = new Set([...strip.querySelectorAll('.cmd')].map((c) => Math.round(c.getBoundingClientRect().top))).size;
+          return { cells, h0, h1: s.height, right: s.right, rows };
         });
+        // One line in a 1280 px window (two fixed rows only where it does not fit).
+        if (w >= 1280) assert.equal(r.rows, 1, `${w} px: the strip on ${r.rows} lines`);
         for (const [id, sw, cw] of r.cells) assert.ok(sw <= cw, `${w} px: ${id} needs ${sw} px, has ${cw}`);
         assert.equal(r.h1, r.h0, `${w} px: strip height`);
         assert.ok(r.right <= w, `${w} px: strip inside the screen`);

@@ -150,6 +150,9 @@ try {
     assert.equal(m.off, 0, `${m.off} of ${m.n} path points off the world's floor`);
     assert.ok(m.lm.every((d) => d < 0.5), `sketched to real landmark [m]: ${m.lm.map((d) => d.toFixed(2))}`);
     assert.ok(m.goal < 0.5, `sketched goal ${m.goal.toFixed(2)} m from the world's`);
+    // The world's landmark label (by the end wall, at the canvas's right edge) is inside it.
+    const labels = await page.$$eval('#layer-world text', (ts) => ts.map((t) => { const b = t.getBBox(); return [t.textContent, b.x, b.x + b.width]; }));
+    for (const l of labels) assert.ok(l[1] >= 0 && l[2] <= 1000, `world label ${l}`);
     await shot(page, 'editor-corridor');
     await openExample('lab');  // the checks below work on the lab sketch
     await page.waitForFunction(() => state.landmarks.length === 8 && !routePending);
