@@ -230,9 +230,11 @@ function renderLandmarks() {
     }
     const order = orderOf(l.id);
     if (order !== null && $('show-route').checked) {
+      // On the box's top-right corner, kept inside the canvas (a box at the edge cut it).
       const b = el('g', { class: 'badge' }, gg);
-      el('circle', { cx: l.x + l.w, cy: l.y, r: 11 }, b);
-      const bt = el('text', { x: l.x + l.w, y: l.y + 4 }, b);
+      const bx = clamp(l.x + l.w, 12, W - 12), by = clamp(l.y, 12, H - 12);
+      el('circle', { cx: bx, cy: by, r: 11 }, b);
+      const bt = el('text', { x: bx, y: by + 4 }, b);
       bt.textContent = String(order + 1);
     }
     if (l.id === selectedId)
@@ -246,14 +248,27 @@ function renderMarks() {
   const s = startPoint(), e = goalPoint();
   if (s) {
     el('circle', { class: 'mark-start', cx: s[0], cy: s[1], r: 14 }, g);
-    const t = el('text', { class: 'mark-label', x: s[0] + 16, y: s[1] + 22, fill: '#1f9d55' }, g);
+    const t = el('text', { class: 'mark-label', fill: '#1f9d55' }, g);
     t.textContent = 'start';
+    placeMarkLabel(t, s);
   }
   if (e) {
     el('circle', { class: 'mark-goal', cx: e[0], cy: e[1], r: 14 }, g);
-    const t = el('text', { class: 'mark-label', x: e[0] + 16, y: e[1] + 22, fill: '#c62828' }, g);
+    const t = el('text', { class: 'mark-label', fill: '#c62828' }, g);
     t.textContent = state.goalDoor === null ? 'goal' : `goal: ${state.goalDoor} m before the door`;
+    placeMarkLabel(t, e);
   }
+}
+
+// A start / goal label below right of its mark, or left of it / above it where that would run
+// off the canvas ("goal: 0.6 m before the door" was cut at the right edge).
+function placeMarkLabel(t, p) {
+  const len = t.getComputedTextLength ? t.getComputedTextLength() : 0;
+  let x = p[0] + 16, y = p[1] + 22;
+  if (x + len > W - 2) x = p[0] - 16 - len;
+  if (y > H - 4) y = p[1] - 18;
+  t.setAttribute('x', clamp(x, 2, Math.max(2, W - 2 - len)));
+  t.setAttribute('y', clamp(y, 14, H - 4));
 }
 
 const deg = (r) => Math.round((r * 180) / Math.PI);
@@ -695,6 +710,9 @@ function renderBackground() {
       el('rect', { class: 'w-lm', x: c[0] - 5, y: c[1] - 5, width: 10, height: 10 }, gg);
       const t = el('text', { class: 'w-lm-label', x: c[0] + 7, y: c[1] - 6 }, gg);
       t.textContent = `${l.id} ${l.class}`;
+      // inside the canvas when the landmark is near its right edge (the corridor's end wall)
+      const len = t.getComputedTextLength ? t.getComputedTextLength() : 0;
+      if (c[0] + 7 + len > W - 2 && c[0] < W) t.setAttribute('x', Math.max(2, W - 2 - len));
     }
     const st = f([0, 0]), ah = f([0.8, 0]);
     el('line', { class: 'w-start', x1: st[0], y1: st[1], x2: ah[0], y2: ah[1] }, gg);

@@ -161,6 +161,7 @@ function render(s) {
   $('start').disabled = s.active;
   $('camera-only').disabled = s.active;
   $('stop').disabled = !s.active;
+  document.body.classList.toggle('active', !!s.active);
   $('capture-frame').disabled = !(s.frame_seq > 0);
   $('capture-box').disabled = !(s.frame_seq > 0 && box);
   if (s.active) startError = null;  // a run is going after all (started elsewhere)
@@ -178,6 +179,7 @@ function render(s) {
   $('section').textContent = s.sections ? `${s.section}/${s.sections}` : '–';
   $('mode').textContent = s.mode || '–';
   $('landmark').textContent = s.landmark || '–';
+  $('landmark').title = s.landmark || '';
   $('time').textContent = fmt(s.t, 1);
   $('pose').textContent = s.pose ? `x ${fmt(s.pose.x)} y ${fmt(s.pose.y)} θ ${fmt(s.pose.theta * 180 / Math.PI, 0)}°` : '';
 
@@ -315,9 +317,13 @@ function renderCard(s) {
   card.append(h, r);
   const dl = document.createElement('dl');
   for (const [k, v] of rows) {
+    // One row per figure: the value beside its name, or under it when both do not fit (never
+    // broken over lines itself).
+    const row = document.createElement('div');
     const dt = document.createElement('dt'); dt.textContent = k;
     const dd = document.createElement('dd'); dd.textContent = v;
-    dl.append(dt, dd);
+    row.append(dt, dd);
+    dl.append(row);
   }
   card.append(dl);
   if (s.run_id) {
@@ -397,10 +403,18 @@ function drawGeometry(g, traj) {
   for (const p of traj) pts.push(p);
   for (const l of g.sketch_landmarks || []) pts.push([l.x, l.y]);
   pts.push([0, 0]);
-  const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
-  const x0 = Math.min(...xs) - 1, x1 = Math.max(...xs) + 1, y0 = Math.min(...ys) - 1, y1 = Math.max(...ys) + 1;
+  const bounds = () => {
+    const xs = pts.map((p) => p[0]), ys = pts.map((p) => p[1]);
+    return [Math.min(...xs) - 1, Math.max(...xs) + 1, Math.min(...ys) - 1, Math.max(...ys) + 1];
+  };
+  // The labels ("L3?") inside the view too: their size follows the view's, so measured from a
+  // first view, then the view grown to take them (they were cut at the map's edge).
+  let [x0, x1, y0, y1] = bounds();
+  const unit0 = Math.max(x1 - x0, y1 - y0) / 60;
+  for (const l of g.sketch_landmarks || []) pts.push([l.x + unit0 * (1.5 + 1.9 * (String(l.id).length + 1)), l.y + unit0 * 4.2]);
+  [x0, x1, y0, y1] = bounds();
   svg.setAttribute('viewBox', `${x0} ${-y1} ${x1 - x0} ${y1 - y0}`);
-  const unit = Math.max(x1 - x0, y1 - y0) / 60;
+  const unit = unit0;
   svg.dataset.unit = unit;
   const base = el('g', { id: 'map-static' }, svg);
   if (g.floor) el('polygon', { class: 'floor', points: g.floor.map(P).join(' '), 'vector-effect': 'non-scaling-stroke' }, base);
@@ -495,15 +509,23 @@ function drawGhost() {
 // ---- plots: ω, v, servo error, inliers, perception ms over the run ----------------------
 const series = { ticks: [], obs: [] };
 let scrubT = null;  // null: follow the run; else the time shown [s]
-function resetSeries() { series.ticks = []; series.obs = []; scrubT = null; drawPlots(); }
+// One request at a time, and an answer only appended where it was asked from: with a slow
+// server (a loaded machine) two overlapping requests both appended the same rows, the next
+// answer then found more rows here than on the server and emptied the plots.
+let seriesBusy = false, seriesEpoch = 0;
+function resetSeries() { series.ticks = []; series.obs = []; scrubT = null; seriesEpoch++; drawPlots(); }
 async function pollSeries() {
+  if (seriesBusy) return;
+  seriesBusy = true;
+  const epoch = seriesEpoch, nt = series.ticks.length, no = series.obs.length;
   try {
-    const r = await api('GET', `/api/run/series?tick=${series.ticks.length}&obs=${series.obs.length}`);
-    if (r.tick_rows < series.ticks.length || r.obs_rows < series.obs.length) { resetSeries(); return; }
+    const r = await api('GET', `/api/run/series?tick=${nt}&obs=${no}`);
+    if (epoch !== seriesEpoch || nt !== series.ticks.length || no !== series.obs.length) return;
+    if (r.tick_rows < nt || r.obs_rows < no) { resetSeries(); return; }
     series.ticks.push(...r.ticks);
     series.obs.push(...r.obs);
     if (r.ticks.length || r.obs.length) drawPlots();
-  } catch (_) { /* the state poll reports a lost server */ }
+  } catch (_) { /* the state poll reports a lost server */ } finally { seriesBusy = false; }
 }
 setInterval(pollSeries, 500);
 

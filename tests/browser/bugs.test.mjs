@@ -149,10 +149,26 @@ try {
     await page.fill('#dist-input', '3');
     await page.click('#dist-ok');
     await page.waitForSelector('.lm[data-id="L2"]');
-    await page.evaluate(() => { const l = state.landmarks.find((x) => x.id === 'L2'); l.x = W - l.w - 4; l.y = 2; render(); });
-    const boxes = await page.$$eval('.lm[data-id="L2"] text', (ts) => ts.map((t) => { const b = t.getBBox(); return [b.x, b.y, b.x + b.width, b.y + b.height]; }));
+    await page.evaluate(() => { const l = state.landmarks.find((x) => x.id === 'L2'); l.x = W - l.w - 4; l.y = 2; changed(); });
+    // With its route order badge (drawn once the route is converted) on the box's corner.
+    await page.waitForFunction(() => !routePending && orderOf('L2') !== null);
+    await page.waitForSelector('.lm[data-id="L2"] .badge');
+    const boxes = await page.$$eval('.lm[data-id="L2"] text, .lm[data-id="L2"] .badge circle', (ts) => ts.map((t) => { const b = t.getBBox(); return [b.x, b.y, b.x + b.width, b.y + b.height]; }));
     const [w, h] = await page.evaluate(() => [W, H]);
     for (const b of boxes) assert.ok(b[0] >= 0 && b[1] >= 0 && b[2] <= w && b[3] <= h, `label ${b} inside ${w}x${h}`);
+  });
+
+  await check('9: the start and goal labels stay inside the canvas at its edges', async () => {
+    // A goal that is a door (its long label) in the bottom-right corner, the start top-left.
+    const saved = await page.evaluate(() => JSON.stringify({ path: state.path, goalDoor: state.goalDoor, start: state.start, goal: state.goal }));
+    const boxes = await page.evaluate(() => {
+      state.start = [6, 6]; state.goal = [W - 8, H - 6]; state.goalDoor = 0.6; render();
+      return [...document.querySelectorAll('#layer-marks text')].map((t) => { const b = t.getBBox(); return [t.textContent, b.x, b.y, b.x + b.width, b.y + b.height]; });
+    });
+    await page.evaluate((s) => { Object.assign(state, JSON.parse(s)); render(); }, saved);
+    const [w, h] = await page.evaluate(() => [W, H]);
+    assert.equal(boxes.length, 2);
+    for (const b of boxes) assert.ok(b[1] >= 0 && b[2] >= 0 && b[3] <= w && b[4] <= h, `'${b[0]}' at ${b.slice(1).map(Math.round)} inside ${w}x${h}`);
   });
 
   await check('9: the active tool button stays readable under the mouse', async () => {
@@ -172,6 +188,22 @@ try {
       assert.ok(r.width > 300 && r.height > 200, `canvas ${r.width}x${r.height}`);
       const sw = await phone.evaluate(() => document.documentElement.scrollWidth);
       assert.ok(sw <= 390, `page ${sw} px wide: no sideways scrolling`);
+      // With a world under the sketch its note sits above the canvas, not over it; the zoom
+      // buttons and the scale bar under it, on the screen; the palette in columns.
+      await phone.selectOption('#open', 'examples/lab.sketch.json');
+      await phone.waitForFunction(() => route !== null);
+      await phone.selectOption('#world', 'lab');
+      await phone.waitForFunction(() => !document.getElementById('bg-note').hidden && /placed as the robot reads/.test(document.getElementById('bg-note').textContent));
+      const c = await phone.locator('#canvas').boundingBox(), n = await phone.locator('#bg-note').boundingBox();
+      assert.ok(n.y + n.height <= c.y + 0.5, `note ${JSON.stringify(n)} over the canvas ${JSON.stringify(c)}`);
+      for (const id of ['#zoom-in', '#zoom-out', '#zoom-fit', '#scale-bar']) {
+        const z = await phone.locator(id).boundingBox();
+        assert.ok(z.y >= c.y + c.height - 0.5 && z.x >= 0 && z.x + z.width <= 390, `${id} ${JSON.stringify(z)} under the canvas ${JSON.stringify(c)}, on the screen`);
+      }
+      const zi = await phone.locator('#zoom-in').boundingBox(), sb = await phone.locator('#scale-bar').boundingBox();
+      assert.ok(sb.x + sb.width <= zi.x, 'scale bar left of the zoom buttons');
+      const tops = await phone.$$eval('.class-card', (cs) => cs.slice(0, 2).map((e) => e.getBoundingClientRect().top));
+      assert.equal(tops[0], tops[1], 'palette cards side by side');
       await phone.screenshot({ path: path.join(out, 'bugs-phone.png'), fullPage: true });
     } finally { await phone.close(); }
   });
@@ -256,6 +288,29 @@ try {
     });
     assert.equal(h1, h0, 'strip height');
     assert.equal(cam1, cam0, 'camera view height');
+  });
+
+  await check('9: the command strip shows its longest values in full (1280, 1024, 820, 390 px wide)', async () => {
+    for (const [w, h] of [[1280, 800], [1024, 768], [820, 1180], [390, 844]]) {
+      const t = await browser.newPage({ viewport: { width: w, height: h } });
+      try {
+        await t.goto(url + 'run.html');
+        await t.waitForSelector('#world option[value="corridor"]', { state: 'attached' });
+        const r = await t.evaluate(() => {
+          const strip = document.getElementById('command-strip'), h0 = strip.getBoundingClientRect().height;
+          const set = { w: '-0.35', v: '0.30', section: '12/12', mode: 'succeeded', landmark: 'L12', time: '999.9' };
+          const cells = Object.entries(set).map(([id, v]) => { const e = document.getElementById(id); e.textContent = v; return [id, e.scrollWidth, e.clientWidth]; });
+          const s = strip.getBoundingClientRect();
+          const rows = new Set([...strip.querySelectorAll('.cmd')].map((c) => Math.round(c.getBoundingClientRect().top))).size;
+          return { cells, h0, h1: s.height, right: s.right, rows };
+        });
+        // One line in a 1280 px window (two fixed rows only where it does not fit).
+        if (w >= 1280) assert.equal(r.rows, 1, `${w} px: the strip on ${r.rows} lines`);
+        for (const [id, sw, cw] of r.cells) assert.ok(sw <= cw, `${w} px: ${id} needs ${sw} px, has ${cw}`);
+        assert.equal(r.h1, r.h0, `${w} px: strip height`);
+        assert.ok(r.right <= w, `${w} px: strip inside the screen`);
+      } finally { await t.close(); }
+    }
   });
 
   await check('9: the world chosen survives a reload', async () => {

@@ -130,6 +130,36 @@ try {
     await shot(page, 'editor-world');
   });
 
+  await check('3: the shipped corridor sketch matches the corridor world: path on its floor, landmark and goal where the world has them', async () => {
+    await openExample('corridor');
+    await page.waitForFunction(() => state.landmarks.length === 1 && !routePending && route && route.sections.length === 1);
+    await page.selectOption('#world', 'corridor');
+    await page.waitForFunction(() => worldMap && worldMap.name === 'corridor' && /placed as the robot reads the sketch/.test(document.getElementById('bg-note').textContent));
+    const m = await page.evaluate(() => {
+      const k = route.scale_m_per_px, floor = document.querySelector('#layer-world polygon.w-floor');
+      const real = [...document.querySelectorAll('#layer-world rect.w-lm')].map((r) => [+r.getAttribute('x') + 5, +r.getAttribute('y') + 5]);
+      const g = document.querySelector('#layer-world circle.w-goal'), goal = goalPoint();
+      const off = state.path.filter((p) => !floor.isPointInFill(new DOMPoint(p[0], p[1])));
+      return {
+        real: real.length, sketched: state.landmarks.length, off: off.length, n: state.path.length,
+        lm: state.landmarks.map((l) => Math.min(...real.map((p) => Math.hypot(p[0] - (l.x + l.w / 2), p[1] - (l.y + l.h / 2)))) * k),
+        goal: Math.hypot(goal[0] - +g.getAttribute('cx'), goal[1] - +g.getAttribute('cy')) * k,
+      };
+    });
+    assert.equal(m.sketched, m.real, `${m.sketched} landmarks sketched, the world has ${m.real}`);
+    assert.equal(m.off, 0, `${m.off} of ${m.n} path points off the world's floor`);
+    assert.ok(m.lm.every((d) => d < 0.5), `sketched to real landmark [m]: ${m.lm.map((d) => d.toFixed(2))}`);
+    assert.ok(m.goal < 0.5, `sketched goal ${m.goal.toFixed(2)} m from the world's`);
+    // The world's landmark label (by the end wall, at the canvas's right edge) is inside it.
+    const labels = await page.$$eval('#layer-world text', (ts) => ts.map((t) => { const b = t.getBBox(); return [t.textContent, b.x, b.x + b.width]; }));
+    for (const l of labels) assert.ok(l[1] >= 0 && l[2] <= 1000, `world label ${l}`);
+    await shot(page, 'editor-corridor');
+    await openExample('lab');  // the checks below work on the lab sketch
+    await page.waitForFunction(() => state.landmarks.length === 8 && !routePending);
+    await page.selectOption('#world', 'lab');
+    await page.waitForFunction(() => worldMap && worldMap.name === 'lab');
+  });
+
   await check('3: zoom, pan and fit change the view, not the sketch; the scale bar follows the zoom', async () => {
     const before = await page.evaluate(() => JSON.stringify(state));
     const vb0 = await viewBox();
@@ -389,6 +419,45 @@ try {
     } finally { await t.close(); }
   });
 
+  // A second page watching the same run through a slow server: every series answer arrives
+  // 1.3 s late, so the 2 Hz poll has several requests out at once (as on a loaded machine,
+  // where the plots of a finished run were seen empty).
+  let observer = null;
+  await check('2: a page whose series answers come late still plots the run (set up)', async () => {
+    observer = await browser.newPage({ viewport: { width: 1280, height: 800 } });
+    await observer.route('**/api/run/series*', async (r) => { await new Promise((ok) => setTimeout(ok, 1300)); await r.continue(); });
+    await observer.route('**/api/run/frame.jpg*', (r) => r.abort());  // its camera view is not looked at: spare the run the JPEG encoding
+    await observer.goto(url + 'run.html');
+    await observer.waitForSelector('#world option[value="corridor"]', { state: 'attached' });
+  });
+
+  for (const [w, h] of [[820, 1180], [390, 844]]) {
+    await check(`7: during a run on a ${w}x${h} screen: STOP stays on screen, the live view comes first, nothing cut`, async () => {
+      const t = await browser.newPage({ viewport: { width: w, height: h }, hasTouch: true });
+      try {
+        await t.goto(url + 'run.html');
+        await t.waitForFunction(() => document.body.classList.contains('active') && document.getElementById('status-badge').textContent === 'running', null, { timeout: 60000, polling: 250 });
+        const stopOnScreen = () => t.evaluate(() => { const b = document.getElementById('stop').getBoundingClientRect(); return b.top >= 0 && b.bottom <= innerHeight && b.height >= 40 && !document.getElementById('stop').disabled; });
+        assert.ok(await stopOnScreen(), 'STOP on the first screen');
+        assert.ok(await t.isHidden('#start'), 'the run form is folded away while the run goes');
+        const cam = await t.locator('#camera-wrap').boundingBox();
+        assert.ok(cam.y < h / 2 && cam.height >= 200, `camera at ${cam.y}, ${cam.height} px high`);
+        await t.locator('#map').scrollIntoViewIfNeeded();
+        assert.ok(await stopOnScreen(), 'STOP still on screen beside the map');
+        // Every value of the command strip readable in full, the strip inside the screen.
+        const cells = await t.evaluate(() => {
+          const set = { w: '-0.35', v: '0.30', section: '12/12', mode: 'succeeded', landmark: 'L12', time: '999.9' };
+          return Object.entries(set).map(([id, v]) => { const e = document.getElementById(id); e.textContent = v; return [id, e.scrollWidth, e.clientWidth]; });
+        });
+        for (const [id, sw, cw] of cells) assert.ok(sw <= cw, `${id}: ${sw} px of text in ${cw} px`);
+        const sw = await t.evaluate(() => document.documentElement.scrollWidth);
+        assert.ok(sw <= w, `page ${sw} px wide`);
+        await t.evaluate(() => scrollTo(0, 0));
+        await t.screenshot({ path: path.join(out, `features-running-${w}x${h}.png`) });
+      } finally { await t.close(); }
+    });
+  }
+
   await check('1: live progress: % of the route, metres left, real-time factor', async () => {
     await page.waitForFunction(() => /\d+ % of the route · [\d.]+ m left · ×[\d.]+ real time/.test(document.getElementById('progress-text').textContent), null, { timeout: 60000 });
     const a = await page.evaluate(async () => (await (await fetch('/api/run/state')).json()).progress);
@@ -472,6 +541,22 @@ try {
     // The recorded runs list names it.
     await page.waitForFunction((id) => [...document.querySelectorAll('#runs .run-id')].some((e) => e.textContent === id), runId);
     await shot(page, 'run-finished');
+  });
+
+  await check('2: the late-answered page holds every row once, in time order', async () => {
+    assert.ok(observer, 'observer page');
+    const rows0 = await page.evaluate(async () => (await (await fetch('/api/run/series?tick=0&obs=0')).json()).tick_rows);
+    assert.ok(rows0 > 20, `${rows0} rows`);
+    await observer.waitForFunction((n) => series.ticks.length >= n, rows0, { timeout: 20000, polling: 250 }).catch(() => {});
+    // Looked at six times over 3 s (the broken poll emptied and refilled the plots every 1-2 s).
+    for (let i = 0; i < 6; i++) {
+      const o = await observer.evaluate(() => series.ticks.map((r) => r[0]));
+      const now = await page.evaluate(async () => (await (await fetch('/api/run/series?tick=0&obs=0')).json()).tick_rows);
+      assert.ok(o.length >= rows0 && o.length <= now, `look ${i}: the page has ${o.length} rows, the server had ${rows0}, has ${now}`);
+      assert.ok(o.every((t, k) => k === 0 || t > o[k - 1]), `look ${i}: rows in time order, none twice`);
+      await page.waitForTimeout(500);
+    }
+    await observer.close();
   });
 
   await check('2: a finished run\'s plots scrub back; the map shows the robot where it was', async () => {

@@ -107,6 +107,14 @@ try {
   assert.ok(await page.locator('#map line.wall').count() > 0, 'walls drawn');
   assert.equal(await page.locator('#map polyline.sketch-path').count(), 1, 'sketch drawn');
   assert.ok((await page.getAttribute('#map-robot', 'points')).length > 0, 'robot drawn');
+  // The sketch's landmark labels ("L1?") are inside the map, not cut at its edge (the corridor
+  // sketch's L1 sits by the end wall: its label reached past the view).
+  const cut = await page.evaluate(() => {
+    const svg = document.getElementById('map'), [x, y, w, h] = svg.getAttribute('viewBox').split(' ').map(Number);
+    return [...svg.querySelectorAll('text')].map((t) => { const b = t.getBBox(); return [t.textContent, b.x, b.y, b.x + b.width, b.y + b.height]; })
+      .filter((b) => b[1] < x - 1e-6 || b[2] < y - 1e-6 || b[3] > x + w + 1e-6 || b[4] > y + h + 1e-6);
+  });
+  assert.deepEqual(cut, [], 'map labels outside the view');
   const shown = await page.evaluate(() => document.getElementById('camera-img').src);
   assert.match(shown, /\/api\/run\/frame\.jpg\?seq=\d+/);
 

@@ -111,6 +111,14 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
         d.window = {100, 60, 80, 100};
         d.inliers = 33;
         o.detections.push_back(d);
+        if (rq.seed == 19) {
+          // A second one at the frame's right edge: its label must be drawn inside the frame.
+          nav::Detection e;
+          e.class_name = "God-Morgon-Red-Grapefruit-Juice";
+          e.window = {270, 150, 48, 60};
+          e.inliers = 19;
+          o.detections.push_back(e);
+        }
         o.timing.windows = 30;
         h.on_observation(f, o);
       }
@@ -281,6 +289,31 @@ TEST_F(UiRunHttp, StartShowsProgressAndStopStopsTheBase) {
   waitFor([](const Json& s) { return s["status"] == "running"; });
   post("/api/run/stop", Json::object());
   waitFor([](const Json& s) { return s["status"] == "stopped"; });
+}
+
+// Issue 29, bug 9: a detection at the frame's right edge had its label cut ("19 inl"): the
+// label (amber, filled) is moved left until it ends inside the frame.
+TEST_F(UiRunHttp, DetectionLabelsStayInsideTheFrame) {
+  ASSERT_EQ(post("/api/run/start", {{"world", "corridor"}, {"seed", 19}})->status, 200);
+  waitFor([](const Json& s) { return s["perception"]["detections"] == 2; });
+  auto f = cli_->Get("/api/run/frame.jpg?windows=0&detections=-1");
+  ASSERT_EQ(f->status, 200);
+  const cv::Mat img =
+      cv::imdecode(std::vector<unsigned char>(f->body.begin(), f->body.end()), cv::IMREAD_COLOR);
+  ASSERT_EQ(img.cols, 320);
+  // The label's band just above the window (y 150): amber pixels left of the window, where
+  // the whole label ("God-Morgon-Red-Grapefruit-Juice  19 inl", wider than the 50 px from the
+  // window to the edge) now starts. Drawn from the window's x it had none there. (Columns
+  // 95-185 hold the camera's own yellow box.)
+  int amber = 0;
+  for (int y = 132; y < 150; ++y)
+    for (int x = 0; x < 260; ++x) {
+      if (x >= 95 && x < 185) continue;
+      const cv::Vec3b p = img.at<cv::Vec3b>(y, x);
+      if (p[0] < 100 && p[1] > 120 && p[1] < 230 && p[2] > 190) ++amber;
+    }
+  EXPECT_GT(amber, 500);
+  post("/api/run/stop", Json::object());
 }
 
 TEST_F(UiRunHttp, StopOnARealRobotStopsTheBaseFromTheRequest) {
