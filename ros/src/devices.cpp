@@ -542,7 +542,9 @@ class RosLaser final : public hw::RangeSensor {
 
  private:
   void onScan(const sensor_msgs::LaserScanConstPtr& m) {
-    in_->wall_last = wallNow();
+    // Fresh for the watchdog only once usable: a scan skipped for want of its mount keeps
+    // nothing fresh (it goes stale, and the robot stops, within ros.stale_timeout_s).
+    const double recv = wallNow();
     const double span = m->angle_max - m->angle_min;
     std::string why;
     if (!std::isfinite(m->angle_min) || !std::isfinite(m->angle_increment) ||
@@ -576,6 +578,7 @@ class RosLaser final : public hw::RangeSensor {
       frame_ = m->header.frame_id;
       mount_ = {x, y, yaw};
     }
+    in_->wall_last = recv;
     hw::RangeScan s;
     s.kind = hw::RangeScan::Kind::Laser;
     s.min_range = m->range_min;
@@ -665,7 +668,7 @@ class RosSonar final : public hw::RangeSensor {
     float range = 0, min_range = 0, max_range = 0, fov = 0;
   };
   void onRange(const sensor_msgs::RangeConstPtr& m) {
-    in_->wall_last = wallNow();
+    const double recv = wallNow();  // fresh for the watchdog once usable (as the laser)
     if (std::isnan(m->range) || !(m->max_range > 0) || !std::isfinite(m->max_range)) {
       {
         std::lock_guard<std::mutex> l(m_);
@@ -687,6 +690,7 @@ class RosSonar final : public hw::RangeSensor {
                 {{"frame", m->header.frame_id}});
       return;
     }
+    in_->wall_last = recv;
     b.range = std::isinf(m->range) ? (m->range > 0 ? m->max_range : m->min_range)
                                    : std::clamp(m->range, m->min_range, m->max_range);
     b.min_range = m->min_range;

@@ -137,7 +137,7 @@ void watchdogLoop() {
       char b[256];
       if (now - last > p.stale_timeout_s) {
         std::snprintf(b, sizeof b,
-                      "%s on %s: no message for %.2f s (limit ros.stale_timeout_s = %.2f s)",
+                      "%s on %s: no usable message for %.2f s (limit ros.stale_timeout_s = %.2f s)",
                       in->what.c_str(), in->topic.c_str(), now - last, p.stale_timeout_s);
         trip(b);
       } else if (n == 0 && in->had_publisher && in->active) {

@@ -91,7 +91,7 @@ Config privateParams();
 
 /// Starts the watchdog with these limits (once; later calls update the limits).
 void startWatchdog(const RosParams& p);
-/// The latched fault ("" while healthy), e.g. "odometry on /odom: no message for 0.52 s".
+/// The latched fault ("" while healthy), e.g. "odometry on /odom: no usable message for 0.52 s".
 std::string fault();
 /// Publishes one zero Twist on the ros:// base's cmd_vel (no-op before the base exists): what
 /// the navigation sends when its route starts, so `ros sim` (holding time at 0) starts too.
