@@ -25,6 +25,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <xmlrpcpp/XmlRpc.h>
 
 #include <algorithm>
 #include <atomic>
@@ -241,11 +242,58 @@ class RosTest : public ::testing::Test {
         });
   }
   void TearDown() override {
+    // Ended with SIGINT where still running, so they leave the master (a SIGKILLed node stays
+    // registered, and the next test's node would take it for its publisher gone).
+    for (auto* p : {&nav_, &sim_})
+      if (*p && (*p)->running()) {
+        (*p)->signal(SIGINT);
+        (*p)->wait(10);
+      }
     nav_.reset();
     sim_.reset();
+    forgetDeadNodes();
     cmd_sub_.shutdown();
     std::error_code ec;
     if (!HasFailure()) fs::remove_all(dir_, ec);
+  }
+
+  // `rosnode cleanup` for this test's master: publishers and subscribers of nodes that no
+  // longer answer (killed on purpose, e.g. the simulator in the kill test) are unregistered.
+  static void forgetDeadNodes() {
+    XmlRpc::XmlRpcValue args, result, payload;
+    args[0] = ros::this_node::getName();
+    if (!ros::master::execute("getSystemState", args, result, payload, false)) return;
+    const std::string me = ros::this_node::getName();
+    for (int kind = 0; kind < 2 && kind < payload.size(); ++kind)  // publishers, subscribers
+      for (int i = 0; i < payload[kind].size(); ++i) {
+        const std::string topic = payload[kind][i][0];
+        for (int j = 0; j < payload[kind][i][1].size(); ++j) {
+          const std::string node = payload[kind][i][1][j];
+          if (node == me) continue;
+          XmlRpc::XmlRpcValue a, r, uri;
+          a[0] = me;
+          a[1] = node;
+          if (!ros::master::execute("lookupNode", a, r, uri, false)) continue;
+          // "http://host:port/" -> host, port; a node that answers getPid is alive.
+          std::string host = static_cast<std::string>(uri).substr(7);
+          host = host.substr(0, host.find('/'));
+          const auto colon = host.rfind(':');
+          if (colon == std::string::npos) continue;
+          XmlRpc::XmlRpcClient probe(host.substr(0, colon).c_str(),
+                                     std::stoi(host.substr(colon + 1)), "/");
+          XmlRpc::XmlRpcValue pa, pr;
+          pa[0] = me;
+          const bool alive = probe.execute("getPid", pa, pr);
+          probe.close();
+          if (alive) continue;
+          XmlRpc::XmlRpcValue u, ur, up;
+          u[0] = node;
+          u[1] = topic;
+          u[2] = uri;
+          ros::master::execute(kind == 0 ? "unregisterPublisher" : "unregisterSubscriber", u, ur,
+                               up, false);
+        }
+      }
   }
 
   std::vector<std::string> cmd(std::initializer_list<std::string> args) {
