@@ -157,15 +157,15 @@ struct RouteView {
 cv::Mat annotate(const hw::Frame& f, const nav::Observation& obs) {
   cv::Mat img = f.image.clone();
   for (const auto& d : obs.detections) {
-    const cv::Scalar c = d.tracked ? cv::Scalar(255, 160, 0)
+    const cv::Scalar c = d.tracked           ? cv::Scalar(255, 160, 0)
                          : d.recognised_only ? cv::Scalar(0, 200, 255)
                                              : cv::Scalar(0, 220, 0);
     cv::rectangle(img, d.window, c, 2);
     char b[96];
     std::snprintf(b, sizeof b, "%s %d%s", d.class_name.c_str(), d.inliers,
                   d.tracked ? " (tracked)" : "");
-    cv::putText(img, b, {d.window.x, std::max(12, d.window.y - 4)}, cv::FONT_HERSHEY_SIMPLEX,
-                0.45, c, 1, cv::LINE_AA);
+    cv::putText(img, b, {d.window.x, std::max(12, d.window.y - 4)}, cv::FONT_HERSHEY_SIMPLEX, 0.45,
+                c, 1, cv::LINE_AA);
   }
   char b[96];
   std::snprintf(b, sizeof b, "%d windows, %.0f ms", obs.timing.windows, obs.timing.total_ms);
@@ -184,16 +184,20 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
             "[--sketch FILE [--exit-on-result]] [--model FILE] [--max-time S] [--out DIR] "
             "[from:=to ...]");
   args.option("sketch", "the hand-drawn map (.sketch.json): start this route at once")
-      .option("model", "landmark model (.slm) for goals that name none; default: the demo set, "
-                       "trained once and cached")
+      .option("model",
+              "landmark model (.slm) for goals that name none; default: the demo set, "
+              "trained once and cached")
       .option("landmarks", "landmark set folder to train the model from (default: share/landmarks)")
       .option("cache-dir", "where trained models are cached (default: ~/.cache/sketchnav)")
-      .option("max-time", "give up a route after this many seconds of ROS time (default: "
-                          "nav.max_time_s)")
-      .option("out", "also write summary.json, events.jsonl, telemetry.csv here (one folder a "
-                     "route)")
-      .flag("exit-on-result", "with --sketch: exit when that route ends (0 success, 1 not) "
-                              "instead of waiting for goals");
+      .option("max-time",
+              "give up a route after this many seconds of ROS time (default: "
+              "nav.max_time_s)")
+      .option("out",
+              "also write summary.json, events.jsonl, telemetry.csv here (one folder a "
+              "route)")
+      .flag("exit-on-result",
+            "with --sketch: exit when that route ends (0 success, 1 not) "
+            "instead of waiting for goals");
   if (!args.parse(argv)) return 0;
   const bool once = args.flagSet("exit-on-result");
   if (once && args.get("sketch").empty())
@@ -206,9 +210,13 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     ros::RosParams rp;
     applyConfig(rp, c, "ros");
     // Every setting checked before anything waits for a topic: a typo fails at once.
-    runSettingsFrom(c);
+    const RunSettings rs = runSettingsFrom(c);
     c.requireAllUsedExcept(driverSettingPrefixes());
     ros::startWatchdog(rp);
+    // The executive grabs a frame once nav.camera_period_s - tick_s / 2 has passed since the
+    // last: such a frame wakes the control loop instead of waiting for its next tick.
+    ros::wakeOnFrames(rp.wake_on_frame ? rs.nav.exec.camera_period_s - 0.5 * rs.nav.exec.tick_s
+                                       : -1.0);
     ros::registerDrivers();
     // The executive's own staleness limits on ROS time: ros.stale_timeout_s unless set.
     for (const char* k :
@@ -220,7 +228,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     // The camera mount from tf (REP 105 base frame -> the image's optical frame).
     std::string camera_frame;
     if (rp.camera_mount_from_tf) {
-      camera_frame = ros::imageFrame(rp.image_topic, rp.wait_s);
+      camera_frame = ros::imageFrame(rp.image_topic, rp.wait_s, rp.image_transport);
       ros::CameraMount m;
       if (!camera_frame.empty() && ros::lookupCameraMount(rp.base_frame, camera_frame, 2.0, m)) {
         if (!c.has("servo.camera_x_m")) c.set("servo.camera_x_m", m.x);
@@ -244,9 +252,9 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     std::unique_ptr<ros::RouteServer> server;
     if (!once) server = std::make_unique<ros::RouteServer>("route");
     // Odometry from nav_msgs/Odometry, or from tf odom -> base_link (REP 105).
-    const std::string base_uri = "ros://base?cmd_vel=" + rp.cmd_vel_topic +
-                                 (rp.odom_source == "tf" ? "&tf=" + rp.odom_frame
-                                                         : "&odom=" + rp.odom_topic);
+    const std::string base_uri =
+        "ros://base?cmd_vel=" + rp.cmd_vel_topic +
+        (rp.odom_source == "tf" ? "&tf=" + rp.odom_frame : "&odom=" + rp.odom_topic);
 
     // One route: the goal's sketch and model (else --model) on the ros:// devices.
     auto runGoal = [&](const ros::RouteGoal& goal) -> Json {
@@ -262,7 +270,8 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
       o.cache_dir = args.get("cache-dir");
       if (!args.get("max-time").empty()) o.max_time_s = args.getDouble("max-time");
       o.robot = base_uri;
-      o.camera = "ros://camera?topic=" + rp.image_topic + "&info=" + rp.camera_info_topic;
+      o.camera = "ros://camera?topic=" + rp.image_topic + "&info=" + rp.camera_info_topic +
+                 "&transport=" + rp.image_transport;
       if (!rp.scan_topic.empty()) o.laser = "ros://laser?topic=" + rp.scan_topic;
       if (!rp.sonar_topic.empty()) o.sonar = "ros://sonar?topic=" + rp.sonar_topic;
       o.config = c;
@@ -345,8 +354,11 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
         // open) fails that goal; the node waits for the next.
         ros::sendZeroCommand();
         log::error("ros", std::string("goal failed before the route ran: ") + e.what());
-        s = {{"success", false}, {"failure", "error"}, {"reason", e.what()},
-             {"sections_done", 0}, {"sections", 0}};
+        s = {{"success", false},
+             {"failure", "error"},
+             {"reason", e.what()},
+             {"sections_done", 0},
+             {"sections", 0}};
       }
       summary = s;
       last_success = s.value("success", false);

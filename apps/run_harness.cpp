@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <cstdio>
@@ -608,6 +609,9 @@ Json runNavigation(const RunOptions& o) {
       while (!ex.done()) {
         next += settings.exec.tick_s;
         dev.clock->sleepUntil(next);
+        // A clock that returned early (the ROS clock when a camera frame arrives) re-phases
+        // the ticks on that instant rather than running the next one a tick_s too early.
+        next = std::min(next, dev.clock->now());
         if (o.stop_requested && o.stop_requested())
           ex.stop("stopped by user");
         else

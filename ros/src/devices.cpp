@@ -4,6 +4,7 @@
 #include <nav_msgs/Odometry.h>
 #include <ros/ros.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/Range.h>
@@ -18,6 +19,7 @@
 #include <initializer_list>
 #include <limits>
 #include <map>
+#include <opencv2/imgcodecs.hpp>
 
 #include "internal.h"
 #include "sketchnav/core/error.h"
@@ -83,14 +85,21 @@ void waitFirst(F have, const std::string& what, const std::string& topic) {
 // ---------------------------------------------------------------------------------------
 class RosCamera final : public hw::Camera {
  public:
-  RosCamera(const std::string& topic, const std::string& info_topic) {
+  // transport "raw": sensor_msgs/Image on `topic`; "compressed": sensor_msgs/CompressedImage
+  // on `topic`/compressed, image_transport's layout (its compressed plugin is not packaged in
+  // Debian bookworm, so the frames are decoded here with OpenCV).
+  RosCamera(const std::string& topic, const std::string& info_topic, const std::string& transport) {
     auto& nh = detail::nodeHandle();
     {
       std::lock_guard<std::mutex> l(state().latency_mutex);
       state().latency.frames.clear();  // seqs start again with this camera
       state().latency.pending = false;
     }
-    sub_ = nh.subscribe(topic, 2, &RosCamera::onImage, this);
+    state().frame_wakes = 0;
+    if (transport == "compressed")
+      sub_ = nh.subscribe(topic + "/compressed", 2, &RosCamera::onCompressed, this);
+    else
+      sub_ = nh.subscribe(topic, 2, &RosCamera::onImage, this);
     if (!info_topic.empty()) info_sub_ = nh.subscribe(info_topic, 2, &RosCamera::onInfo, this);
     describe(*in_, "camera", sub_);
     uri_ = "ros://camera?topic=" + sub_.getTopic();
@@ -131,6 +140,7 @@ class RosCamera final : public hw::Camera {
                                   [this] { return seq_ > delivered_; });
     if (!got) return hw::GrabStatus::Timeout;
     delivered_ = seq_;
+    delivered_stamp_ = stamp_;
     {
       std::lock_guard<std::mutex> ll(state().latency_mutex);
       auto it = state().latency.frames.find(seq_);
@@ -185,18 +195,59 @@ class RosCamera final : public hw::Camera {
       bad("encoding '" + m->encoding + "' is not a colour or grey image (" + e.what() + ")");
       return;
     }
+    deliver(img, m->header.stamp, recv, transport);
+  }
+  void onCompressed(const sensor_msgs::CompressedImageConstPtr& m) {
+    const double recv = wallNow();
+    in_->wall_last = recv;
+    const double transport = !::ros::Time::isSimTime() && !m->header.stamp.isZero()
+                                 ? (::ros::Time::now() - m->header.stamp).toSec()
+                                 : -1;
+    if (m->data.empty()) {
+      bad("empty compressed image (format '" + m->format + "', 0 bytes)");
+      return;
+    }
+    // compressedDepth (16-bit depth in a PNG behind a header) is no camera image.
+    if (m->format.find("compressedDepth") != std::string::npos) {
+      bad("compressed format '" + m->format + "' is a depth image, not a colour or grey image");
+      return;
+    }
+    cv::Mat img;
+    try {
+      img = cv::imdecode(m->data, cv::IMREAD_COLOR);  // jpeg / png, grey -> bgr
+    } catch (const std::exception&) {
+      img.release();
+    }
+    if (img.empty()) {
+      bad("compressed image (format '" + m->format + "', " + std::to_string(m->data.size()) +
+          " bytes) does not decode");
+      return;
+    }
+    deliver(img, m->header.stamp, recv, transport);
+  }
+  // A checked, converted frame: the latest, for grab(); wakes the control loop when it is due.
+  void deliver(const cv::Mat& img, const ::ros::Time& stamp, double recv, double transport) {
+    bool due = false;
     {
       std::lock_guard<std::mutex> l(m_);
       latest_ = img;
-      stamp_ = stampOf(m->header.stamp);
+      stamp_ = stampOf(stamp);
       ++seq_;
       ++st_.received;
+      due = stamp_ >= delivered_stamp_ + state().wake_gap_s;
       std::lock_guard<std::mutex> ll(state().latency_mutex);
       auto& fr = state().latency.frames;
       fr[seq_] = {recv, wallNow(), -1, transport};
       while (fr.size() > 50) fr.erase(fr.begin());
     }
     cv_.notify_all();
+    if (due && state().wake_gap_s >= 0) {
+      {
+        std::lock_guard<std::mutex> l(state().wake_m);
+        ++state().frames_due;
+      }
+      state().wake_cv.notify_all();
+    }
   }
   void onInfo(const sensor_msgs::CameraInfoConstPtr& m) {
     if (m->width == 0 || m->height == 0 || !(m->K[0] > 0) || !(m->K[4] > 0)) return;
@@ -218,6 +269,7 @@ class RosCamera final : public hw::Camera {
   cv::Mat latest_;
   double stamp_ = 0;
   std::uint64_t seq_ = 0, delivered_ = 0;
+  double delivered_stamp_ = -1e300;  // [s] the stamp of the last frame grab() handed out
   hw::Intrinsics intr_;
   bool have_info_ = false;
   hw::DeviceStats st_;
@@ -355,7 +407,9 @@ class RosBase final : public hw::Base {
     have_ = true;
   }
 
-  static std::string strip(const std::string& f) { return !f.empty() && f[0] == '/' ? f.substr(1) : f; }
+  static std::string strip(const std::string& f) {
+    return !f.empty() && f[0] == '/' ? f.substr(1) : f;
+  }
 
   // tf: the odom -> base transform of this message (direct), else through the tf buffer when
   // the message moves the odometry frame's tree (odom -> base_footprint -> base_link).
@@ -488,7 +542,9 @@ class RosLaser final : public hw::RangeSensor {
 
  private:
   void onScan(const sensor_msgs::LaserScanConstPtr& m) {
-    in_->wall_last = wallNow();
+    // Fresh for the watchdog only once usable: a scan skipped for want of its mount keeps
+    // nothing fresh (it goes stale, and the robot stops, within ros.stale_timeout_s).
+    const double recv = wallNow();
     const double span = m->angle_max - m->angle_min;
     std::string why;
     if (!std::isfinite(m->angle_min) || !std::isfinite(m->angle_increment) ||
@@ -522,6 +578,7 @@ class RosLaser final : public hw::RangeSensor {
       frame_ = m->header.frame_id;
       mount_ = {x, y, yaw};
     }
+    in_->wall_last = recv;
     hw::RangeScan s;
     s.kind = hw::RangeScan::Kind::Laser;
     s.min_range = m->range_min;
@@ -611,7 +668,7 @@ class RosSonar final : public hw::RangeSensor {
     float range = 0, min_range = 0, max_range = 0, fov = 0;
   };
   void onRange(const sensor_msgs::RangeConstPtr& m) {
-    in_->wall_last = wallNow();
+    const double recv = wallNow();  // fresh for the watchdog once usable (as the laser)
     if (std::isnan(m->range) || !(m->max_range > 0) || !std::isfinite(m->max_range)) {
       {
         std::lock_guard<std::mutex> l(m_);
@@ -633,6 +690,7 @@ class RosSonar final : public hw::RangeSensor {
                 {{"frame", m->header.frame_id}});
       return;
     }
+    in_->wall_last = recv;
     b.range = std::isinf(m->range) ? (m->range > 0 ? m->max_range : m->min_range)
                                    : std::clamp(m->range, m->min_range, m->max_range);
     b.min_range = m->min_range;
@@ -686,13 +744,10 @@ Json latencySummary() {
   };
   std::vector<double> over;
   for (size_t i = 0; i < L.total.size(); ++i) over.push_back(L.total[i] - L.grab_to_cmd[i]);
-  return {{"frames", L.total.size()},
-          {"transport", ms(L.transport)},
-          {"convert", ms(L.convert)},
-          {"wait", ms(L.wait)},
-          {"grab_to_cmd", ms(L.grab_to_cmd)},
-          {"total", ms(L.total)},
-          {"ros_overhead", ms(over)}};
+  return {{"frames", L.total.size()},     {"frame_wakes", state().frame_wakes.load()},
+          {"transport", ms(L.transport)}, {"convert", ms(L.convert)},
+          {"wait", ms(L.wait)},           {"grab_to_cmd", ms(L.grab_to_cmd)},
+          {"total", ms(L.total)},         {"ros_overhead", ms(over)}};
 }
 
 void registerDrivers() {
@@ -702,17 +757,22 @@ void registerDrivers() {
     r.addCamera("ros",
                 [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Camera> {
                   ctx.clock = clock();
+                  const std::string transport = u.param("transport", "raw");
+                  if (transport != "raw" && transport != "compressed")
+                    throw InputError(u.text + ": unknown transport '" + transport +
+                                     "' (raw or compressed)");
                   return std::make_unique<RosCamera>(topicParam(u, "topic", "image_raw"),
-                                                     u.param("info", "camera_info"));
+                                                     u.param("info", "camera_info"), transport);
                 },
-                {"topic", "info"});
+                {"topic", "info", "transport"});
     r.addBase("ros",
               [](const Uri& u, hw::DeviceContext& ctx) -> std::unique_ptr<hw::Base> {
                 ctx.clock = clock();
                 const std::string tf = u.param("tf", "");
                 if (!tf.empty() && !u.param("odom", "").empty())
-                  throw InputError(u.text + ": odometry from 'odom' (a topic) or 'tf' (a frame), "
-                                            "not both");
+                  throw InputError(u.text +
+                                   ": odometry from 'odom' (a topic) or 'tf' (a frame), "
+                                   "not both");
                 return std::make_unique<RosBase>(topicParam(u, "cmd_vel", "cmd_vel"),
                                                  tf.empty() ? topicParam(u, "odom", "odom") : "",
                                                  tf);

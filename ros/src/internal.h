@@ -5,6 +5,7 @@
 #include <tf2_ros/transform_listener.h>
 
 #include <atomic>
+#include <condition_variable>
 #include <functional>
 #include <map>
 #include <memory>
@@ -31,7 +32,7 @@ struct Input {
 struct Latency {
   struct FrameTimes {
     double recv = -1, ready = -1, grab = -1;  // [s, wallNow()] callback, converted, grabbed
-    double transport = -1;        // [s] stamp -> callback (wall-time robots only)
+    double transport = -1;                    // [s] stamp -> callback (wall-time robots only)
   };
   std::map<std::uint64_t, FrameTimes> frames;  // by camera seq, the last ~50
   bool pending = false;
@@ -56,6 +57,14 @@ struct State {
   std::atomic<bool> watchdog_stop{false};
   std::mutex latency_mutex;
   Latency latency;
+  // Wake on frame (RosParams::wake_on_frame): the camera counts frames the executive will
+  // grab (stamped at least wake_gap_s after the last one it took); the clock's sleepUntil()
+  // returns as soon as one arrives.
+  std::atomic<double> wake_gap_s{-1.0};  // [s] < 0: off
+  std::mutex wake_m;
+  std::condition_variable wake_cv;
+  std::uint64_t frames_due = 0;               // guarded by wake_m
+  std::atomic<std::uint64_t> frame_wakes{0};  // sleeps a frame ended early (this camera's)
 };
 
 State& state();

@@ -1,5 +1,6 @@
 #include <geometry_msgs/Twist.h>
 #include <ros/ros.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <std_msgs/String.h>
 #include <tf2/LinearMath/Matrix3x3.h>
@@ -136,7 +137,7 @@ void watchdogLoop() {
       char b[256];
       if (now - last > p.stale_timeout_s) {
         std::snprintf(b, sizeof b,
-                      "%s on %s: no message for %.2f s (limit ros.stale_timeout_s = %.2f s)",
+                      "%s on %s: no usable message for %.2f s (limit ros.stale_timeout_s = %.2f s)",
                       in->what.c_str(), in->topic.c_str(), now - last, p.stale_timeout_s);
         trip(b);
       } else if (n == 0 && in->had_publisher && in->active) {
@@ -251,10 +252,24 @@ class RosClock final : public hw::Clock {
   double now() const override { return ::ros::Time::now().toSec(); }
   void sleepUntil(double t) override {
     // Returns early on a fault: under simulated time a dead simulator freezes /clock, and the
-    // executive must still reach its next tick to stop.
-    while (now() < t && !state().tripped && ::ros::ok())
-      std::this_thread::sleep_for(std::chrono::microseconds(500));
+    // executive must still reach its next tick to stop. Returns early, too, when a camera
+    // frame the executive will grab arrives (wakeOnFrames()): the frame need not wait for the
+    // next tick (up to a whole tick_s otherwise). Each such frame wakes it once.
+    State& s = state();
+    std::unique_lock<std::mutex> l(s.wake_m);
+    while (now() < t && !s.tripped && ::ros::ok()) {
+      if (s.wake_gap_s >= 0 && s.frames_due > woken_) {
+        ++s.frame_wakes;
+        break;
+      }
+      // Polled as well: under simulated time now() moves with /clock, not with a notify.
+      s.wake_cv.wait_for(l, std::chrono::microseconds(500));
+    }
+    woken_ = s.frames_due;
   }
+
+ private:
+  std::uint64_t woken_ = 0;  // frames_due when sleepUntil() last returned (guarded by wake_m)
 };
 
 }  // namespace
@@ -265,6 +280,9 @@ void RosParams::validate() const {
   require(wait_s > 0, "ros.wait_s", "must be > 0 s");
   require(master_check_s > 0 && master_check_s <= 5, "ros.master_check_s", "must be in (0, 5] s");
   require(!image_topic.empty(), "ros.image_topic", "must not be empty (landmarks need a camera)");
+  require(image_transport == "raw" || image_transport == "compressed", "ros.image_transport",
+          "must be 'raw' (sensor_msgs/Image) or 'compressed' (sensor_msgs/CompressedImage on "
+          "<image_topic>/compressed)");
   require(!odom_topic.empty(), "ros.odom_topic", "must not be empty");
   require(!cmd_vel_topic.empty(), "ros.cmd_vel_topic", "must not be empty");
   require(!base_frame.empty(), "ros.base_frame", "must not be empty");
@@ -338,7 +356,19 @@ void shutdown() {
 Config privateParams() {
   XmlRpc::XmlRpcValue v;
   if (!::ros::param::get("~", v) || v.getType() != XmlRpc::XmlRpcValue::TypeStruct) return Config();
-  return Config::fromJson(toJson(v), "ROS parameters of " + ::ros::this_node::getName());
+  Json j = toJson(v);
+  // image_transport's own convention, `_image_transport:=compressed` (~image_transport),
+  // is ros.image_transport.
+  if (j.contains("image_transport")) {
+    Json& r = j["ros"];
+    if (!r.is_object()) r = Json::object();
+    if (r.contains("image_transport") && r["image_transport"] != j["image_transport"])
+      throw InputError("ROS parameters of " + ::ros::this_node::getName() +
+                       ": ~image_transport and ~ros/image_transport disagree");
+    r["image_transport"] = j["image_transport"];
+    j.erase("image_transport");
+  }
+  return Config::fromJson(j, "ROS parameters of " + ::ros::this_node::getName());
 }
 
 void startWatchdog(const RosParams& p) {
@@ -383,6 +413,10 @@ void resetFault() {
   s.tripped = false;
 }
 
+void wakeOnFrames(double min_gap_s) {
+  state().wake_gap_s = min_gap_s;
+}
+
 std::shared_ptr<hw::Clock> clock() {
   static auto c = std::make_shared<RosClock>();
   return c;
@@ -425,22 +459,31 @@ bool lookupCameraMount(const std::string& base_frame, const std::string& camera_
   return true;
 }
 
-std::string imageFrame(const std::string& topic, double timeout_s) {
+namespace {
+template <class Msg>
+std::string frameOf(const std::string& topic, double timeout_s) {
   auto frame = std::make_shared<std::pair<std::mutex, std::string>>();
   auto got = std::make_shared<std::atomic<bool>>(false);
-  boost::function<void(const sensor_msgs::ImageConstPtr&)> cb =
-      [frame, got](const sensor_msgs::ImageConstPtr& m) {
+  boost::function<void(const boost::shared_ptr<const Msg>&)> cb =
+      [frame, got](const boost::shared_ptr<const Msg>& m) {
         std::lock_guard<std::mutex> l(frame->first);
         frame->second = m->header.frame_id;
         *got = true;
       };
-  auto sub = detail::nodeHandle().subscribe<sensor_msgs::Image>(topic, 1, cb);
+  auto sub = detail::nodeHandle().subscribe<Msg>(topic, 1, cb);
   const double t0 = detail::wallNow();
   while (!*got && detail::wallNow() - t0 < timeout_s && !g_signal)
     std::this_thread::sleep_for(std::chrono::milliseconds(10));
   sub.shutdown();
   std::lock_guard<std::mutex> l(frame->first);
   return frame->second;
+}
+}  // namespace
+
+std::string imageFrame(const std::string& topic, double timeout_s, const std::string& transport) {
+  return transport == "compressed"
+             ? frameOf<sensor_msgs::CompressedImage>(topic + "/compressed", timeout_s)
+             : frameOf<sensor_msgs::Image>(topic, timeout_s);
 }
 
 struct JsonPublisher::Impl {

@@ -7,6 +7,7 @@
 #include <ros/ros.h>
 #include <rosgraph_msgs/Clock.h>
 #include <sensor_msgs/CameraInfo.h>
+#include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/Range.h>
@@ -21,6 +22,7 @@
 #include <filesystem>
 #include <limits>
 #include <mutex>
+#include <opencv2/imgcodecs.hpp>
 #include <thread>
 
 #include "internal.h"
@@ -97,6 +99,9 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   ::ros::param::set("/use_sim_time", true);
   auto pub_clock = nh.advertise<rosgraph_msgs::Clock>("/clock", 10);
   auto pub_img = nh.advertise<sensor_msgs::Image>("image_raw", 2);
+  // image_transport's compressed topic (jpeg, compressed_image_transport's format string),
+  // encoded only while something subscribes to it.
+  auto pub_jpeg = nh.advertise<sensor_msgs::CompressedImage>("image_raw/compressed", 2);
   auto pub_info = nh.advertise<sensor_msgs::CameraInfo>("camera_info", 2);
   auto pub_odom = nh.advertise<nav_msgs::Odometry>("odom", 20);
   auto pub_truth = nh.advertise<nav_msgs::Odometry>("ground_truth", 20);
@@ -175,6 +180,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   sensor_msgs::LaserScan scan_msg;
   std::vector<sensor_msgs::Range> sonar_msgs;
   sensor_msgs::ImagePtr img_msg;
+  sensor_msgs::CompressedImagePtr jpeg_msg;
   sensor_msgs::CameraInfo info_msg;
 
   bool collision_logged = false;
@@ -270,6 +276,15 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
         h.seq = static_cast<std::uint32_t>(f.seq);
         img_msg = cv_bridge::CvImage(h, "bgr8", f.image).toImageMsg();
         pub_img.publish(img_msg);
+        jpeg_msg.reset();
+        if (pub_jpeg.getNumSubscribers() > 0) {
+          auto c = boost::make_shared<sensor_msgs::CompressedImage>();
+          c->header = h;
+          c->format = "bgr8; jpeg compressed bgr8";
+          cv::imencode(".jpg", f.image, c->data, {cv::IMWRITE_JPEG_QUALITY, 90});
+          jpeg_msg = c;
+          pub_jpeg.publish(jpeg_msg);
+        }
         sensor_msgs::CameraInfo& ci = info_msg;
         ci.header = h;
         ci.width = K.width;
@@ -313,6 +328,15 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
       for (const auto& m : sonar_msgs) pub_sonar.publish(m);
       if (img_msg) {
         pub_img.publish(img_msg);
+        if (!jpeg_msg && pub_jpeg.getNumSubscribers() > 0) {  // a subscriber that joined late
+          auto c = boost::make_shared<sensor_msgs::CompressedImage>();
+          c->header = img_msg->header;
+          c->format = "bgr8; jpeg compressed bgr8";
+          cv::imencode(".jpg", cv_bridge::toCvShare(img_msg)->image, c->data,
+                       {cv::IMWRITE_JPEG_QUALITY, 90});
+          jpeg_msg = c;
+        }
+        if (jpeg_msg) pub_jpeg.publish(jpeg_msg);
         pub_info.publish(info_msg);
       }
       std::this_thread::sleep_for(std::chrono::milliseconds(100));

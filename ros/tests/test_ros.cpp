@@ -25,6 +25,7 @@
 #include <tf2_msgs/TFMessage.h>
 #include <unistd.h>
 #include <visualization_msgs/MarkerArray.h>
+#include <xmlrpcpp/XmlRpc.h>
 
 #include <algorithm>
 #include <atomic>
@@ -231,6 +232,9 @@ class RosTest : public ::testing::Test {
     fs::create_directories(dir_);
     // A simulator of an earlier test left simulated time on: this one starts on wall time.
     ros::param::del("/use_sim_time");
+    // Private parameters an earlier node set (`_image_transport:=compressed` stays on the
+    // master after its node ends): each test's node starts from its own arguments.
+    ros::param::del("/sketchnav_nav");
     cmd_sub_ = nh_->subscribe<geometry_msgs::Twist>(
         "cmd_vel", 100, [this](const geometry_msgs::TwistConstPtr& m) {
           std::lock_guard<std::mutex> l(m_);
@@ -238,11 +242,58 @@ class RosTest : public ::testing::Test {
         });
   }
   void TearDown() override {
+    // Ended with SIGINT where still running, so they leave the master (a SIGKILLed node stays
+    // registered, and the next test's node would take it for its publisher gone).
+    for (auto* p : {&nav_, &sim_})
+      if (*p && (*p)->running()) {
+        (*p)->signal(SIGINT);
+        (*p)->wait(10);
+      }
     nav_.reset();
     sim_.reset();
+    forgetDeadNodes();
     cmd_sub_.shutdown();
     std::error_code ec;
     if (!HasFailure()) fs::remove_all(dir_, ec);
+  }
+
+  // `rosnode cleanup` for this test's master: publishers and subscribers of nodes that no
+  // longer answer (killed on purpose, e.g. the simulator in the kill test) are unregistered.
+  static void forgetDeadNodes() {
+    XmlRpc::XmlRpcValue args, result, payload;
+    args[0] = ros::this_node::getName();
+    if (!ros::master::execute("getSystemState", args, result, payload, false)) return;
+    const std::string me = ros::this_node::getName();
+    for (int kind = 0; kind < 2 && kind < payload.size(); ++kind)  // publishers, subscribers
+      for (int i = 0; i < payload[kind].size(); ++i) {
+        const std::string topic = payload[kind][i][0];
+        for (int j = 0; j < payload[kind][i][1].size(); ++j) {
+          const std::string node = payload[kind][i][1][j];
+          if (node == me) continue;
+          XmlRpc::XmlRpcValue a, r, uri;
+          a[0] = me;
+          a[1] = node;
+          if (!ros::master::execute("lookupNode", a, r, uri, false)) continue;
+          // "http://host:port/" -> host, port; a node that answers getPid is alive.
+          std::string host = static_cast<std::string>(uri).substr(7);
+          host = host.substr(0, host.find('/'));
+          const auto colon = host.rfind(':');
+          if (colon == std::string::npos) continue;
+          XmlRpc::XmlRpcClient probe(host.substr(0, colon).c_str(),
+                                     std::stoi(host.substr(colon + 1)), "/");
+          XmlRpc::XmlRpcValue pa, pr;
+          pa[0] = me;
+          const bool alive = probe.execute("getPid", pa, pr);
+          probe.close();
+          if (alive) continue;
+          XmlRpc::XmlRpcValue u, ur, up;
+          u[0] = node;
+          u[1] = topic;
+          u[2] = uri;
+          ros::master::execute(kind == 0 ? "unregisterPublisher" : "unregisterSubscriber", u, ur,
+                               up, false);
+        }
+      }
   }
 
   std::vector<std::string> cmd(std::initializer_list<std::string> args) {
@@ -427,8 +478,13 @@ TEST_F(RosTest, ACollisionInTheSimulatorStopsItsOdometry) {
 struct Garbage {
   const char* name;
   const char* expect;             // in the node's stderr
-  const char* also_ok = nullptr;  // or this (two supervisors may see it first)
+  const char* also_ok = nullptr;  // or one of these, '|'-separated (two supervisors may see
+                                  // it first)
   bool tf_odometry = false;       // odometry as a tf odom -> base_link (ros.odom_source=tf)
+  bool compressed = false;        // the camera as sensor_msgs/CompressedImage (jpeg) on
+                                  // image_raw/compressed only, the node on ~image_transport
+  double stale_s = 0;             // [s] the fault is an input going stale this long after
+                                  // the garbage starts (ros.stale_timeout_s)
 };
 void PrintTo(const Garbage& g, std::ostream* os) {
   *os << g.name;
@@ -440,11 +496,15 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
   // This process is the robot: wall time (no /clock), a camera, odometry and a laser whose
   // frames are the base frame (no tf needed), 20 Hz.
   auto img_pub = nh_->advertise<sensor_msgs::Image>("image_raw", 2);
+  auto jpeg_pub = nh_->advertise<sensor_msgs::CompressedImage>("image_raw/compressed", 2);
   auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
   auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
   auto scan_pub = nh_->advertise<sensor_msgs::LaserScan>("scan", 5);
   auto tf_pub = nh_->advertise<tf2_msgs::TFMessage>("/tf", 5);
   std::atomic<bool> stop{false}, bad{false};
+  std::atomic<double> last_good{-1};  // [s, wallNow()] the robot's last all-good messages
+  std::vector<unsigned char> jpeg;
+  cv::imencode(".jpg", cv::Mat(48, 64, CV_8UC3, cv::Scalar::all(90)), jpeg);
   std::thread robot([&] {
     while (!stop) {
       const ros::Time now = ros::Time::now();
@@ -466,7 +526,18 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
         im.step = 64 * 4;
         im.data.assign(64 * 48 * 4, 0);
       }
-      if (!(b && std::string(g.name) == "frozen_camera")) img_pub.publish(im);
+      if (g.compressed) {
+        sensor_msgs::CompressedImage c;
+        c.header = im.header;
+        c.format = "bgr8; jpeg compressed bgr8";
+        c.data = jpeg;
+        if (b && std::string(g.name) == "undecodable_compressed")
+          c.data.assign(jpeg.size(), 0x5a);  // same length, not a jpeg
+        if (b && std::string(g.name) == "empty_compressed") c.data.clear();
+        jpeg_pub.publish(c);  // and no raw image: the node must decode these to start
+      } else if (!(b && std::string(g.name) == "frozen_camera")) {
+        img_pub.publish(im);
+      }
       sensor_msgs::CameraInfo ci;
       ci.header = im.header;
       ci.width = 64;
@@ -519,18 +590,23 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
       sc.ranges.assign(201, 5.0f);
       if (b && std::string(g.name) == "scan_wrong_length") sc.ranges.resize(50);
       scan_pub.publish(sc);
+      if (!b) last_good = wallNow();
       std::this_thread::sleep_for(std::chrono::milliseconds(50));
     }
   });
   std::vector<std::string> args = {
       "--set", "ros.sonar_topic=", "--set", "ros.camera_mount_from_tf=false", "--max-time", "60"};
   if (g.tf_odometry) args.insert(args.end(), {"--set", "ros.odom_source=tf"});
+  // image_transport's parameter convention (~image_transport = ros.image_transport).
+  if (g.compressed) args.push_back("_image_transport:=compressed");
   startNav(shortLabSketch(dir_), args);
   // Running: the route has started (its first commands).
   const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
   bool ran = nav_->running();
+  double fault_wall = -1;
   if (started && ran) {
     std::this_thread::sleep_for(std::chrono::milliseconds(500));
+    fault_wall = wallNow();
     if (std::string(g.name) == "sigint")
       nav_->signal(SIGINT);
     else
@@ -545,13 +621,31 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
   EXPECT_EQ(nav_->exitCode(), 1) << logs();
   const std::string err = nav_->err();
   EXPECT_NE(err.find("safety stop"), std::string::npos) << logs();
-  EXPECT_TRUE(err.find(g.expect) != std::string::npos ||
-              (g.also_ok && err.find(g.also_ok) != std::string::npos))
-      << logs();
+  bool said = err.find(g.expect) != std::string::npos;
+  if (g.also_ok) {
+    std::stringstream alternatives(g.also_ok);
+    for (std::string a; std::getline(alternatives, a, '|');)
+      said = said || err.find(a) != std::string::npos;
+  }
+  EXPECT_TRUE(said) << logs();
   const auto c = commands();
   ASSERT_FALSE(c.empty());
   EXPECT_EQ(c.back().v, 0.0);
   EXPECT_EQ(c.back().w, 0.0);
+  // The stop: the first command after the fault from which on every command is zero. Within
+  // 0.5 s of the fault, as seen by this node: of the garbage being sent, or for a stale input
+  // of its going stale (its last message + ros.stale_timeout_s).
+  if (g.stale_s > 0) fault_wall = last_good;
+  double stop_wall = -1;
+  for (auto it = c.rbegin();
+       it != c.rend() && it->wall >= fault_wall && it->v == 0.0 && it->w == 0.0; ++it)
+    stop_wall = it->wall;
+  ASSERT_GE(stop_wall, 0) << "no zero cmd_vel after the fault" << logs();
+  const double delay = stop_wall - fault_wall - g.stale_s;
+  std::printf("%s -> zero cmd_vel %.3f s after the %s\n", g.name, delay,
+              g.stale_s > 0 ? "input went stale (last message + 0.5 s)" : "fault");
+  RecordProperty("stop_delay_ms", static_cast<int>(delay * 1000));
+  EXPECT_LT(delay, 0.5) << logs();
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -568,13 +662,23 @@ INSTANTIATE_TEST_SUITE_P(
         Garbage{"zero_quaternion_tf",
                 "odometry (tf odom -> base_link): rotation is a zero quaternion", nullptr, true},
         Garbage{"scan_wrong_length", "the scan has 50 ranges"},
-        // tf2 refuses the NaN mount (nothing to look up): scans skipped, then
-        // the range supervisor's stop; a NaN that got through: mountOf's own.
-        Garbage{"nan_laser_mount", "no tf for the laser frame yet",
-                "the sensor mount is not finite"},
-        Garbage{"frozen_camera", "camera on /image_raw: no message for",
+        // tf2 refuses the NaN mount (nothing to look up): scans skipped, so the laser goes
+        // stale (the watchdog's stop); a NaN that got through: mountOf's own.
+        Garbage{"nan_laser_mount", "laser scan on /scan: no usable message for",
                 // the executive's own check on ROS time, same 0.5 s limit
-                "safety stop: camera stale: no data for"},
+                "the sensor mount is not finite|safety stop: range data stale: no data for", false,
+                false, 0.5},
+        Garbage{"frozen_camera", "camera on /image_raw: no usable message for",
+                // the executive's own check on ROS time, same 0.5 s limit
+                "safety stop: camera stale: no data for", false, false, 0.5},
+        // The compressed transport: the route starts on decoded jpeg frames only, then
+        // frames that do not decode, or carry no data, stop it.
+        Garbage{"undecodable_compressed",
+                "camera on /image_raw/compressed: compressed image (format 'bgr8; jpeg "
+                "compressed bgr8'",
+                nullptr, false, true},
+        Garbage{"empty_compressed", "camera on /image_raw/compressed: empty compressed image",
+                nullptr, false, true},
         Garbage{"sigint", "SIGINT received"}),
     [](const ::testing::TestParamInfo<Garbage>& i) { return std::string(i.param.name); });
 
@@ -641,16 +745,30 @@ TEST(RosMaster, LosingTheMasterStopsTheRoute) {
   std::this_thread::sleep_for(std::chrono::milliseconds(1000));
   master->signal(SIGKILL);
   const double killed = wallNow();
+  // The stop: the node logs its safety stop right after publishing the zero cmd_vel (no node
+  // of this test can watch cmd_vel: this process is on another master, and this one is dead).
+  double stopped = -1;
+  while (stopped < 0 && wallNow() - killed < 10) {
+    if (nav.err().find("cannot be reached (zero cmd_vel sent") != std::string::npos)
+      stopped = wallNow() - killed;
+    else
+      std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  }
   ASSERT_TRUE(nav.wait(10)) << nav.err();
   const double ended = wallNow() - killed;
+  ASSERT_GE(stopped, 0) << nav.err();
+  RecordProperty("stop_delay_ms", static_cast<int>(stopped * 1000));
+  EXPECT_LT(stopped, 0.5) << nav.err();
   EXPECT_EQ(nav.exitCode(), 1) << nav.err();
   const Json r = Json::parse(nav.out());
   EXPECT_FALSE(r["success"].get<bool>());
   EXPECT_NE(r["reason"].get<std::string>().find("ROS master at " + uri + " cannot be reached"),
             std::string::npos)
       << r["reason"];
-  std::printf("master killed -> route ended after %.2f s: %s\n", ended,
-              r["reason"].get<std::string>().c_str());
+  std::printf(
+      "master killed -> safety stop (zero cmd_vel) after %.3f s, route ended after "
+      "%.2f s: %s\n",
+      stopped, ended, r["reason"].get<std::string>().c_str());
   sim.signal(SIGKILL);
   if (!saved.empty()) ::setenv("ROS_MASTER_URI", saved.c_str(), 1);
   fs::remove_all(dir);
@@ -1024,6 +1142,15 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
     EXPECT_EQ(c.back().v, 0.0);
     EXPECT_EQ(c.back().w, 0.0);
     EXPECT_GT(c.back().wall, t4);
+    // ... and read back with rostopic alone: the latched ~result says so.
+    const fs::path echoed = dir_ / "result.yaml";
+    ASSERT_EQ(std::system(("timeout 30 rostopic echo -n 1 /sketchnav_nav/result > " +
+                           echoed.string() + " 2>&1")
+                              .c_str()),
+              0)
+        << slurp(echoed.string());
+    EXPECT_NE(slurp(echoed.string()).find("cancelled"), std::string::npos)
+        << slurp(echoed.string());
   }
   // The server ends on SIGINT, exit 0.
   nav_->signal(SIGINT);
@@ -1031,15 +1158,19 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
   EXPECT_EQ(nav_->exitCode(), 0) << logs();
 }
 
-// REP 105 odometry from tf: the simulator's nav_msgs/Odometry moved off /odom, the node takes
-// odom -> base_link from tf and still drives the short route.
-TEST_F(RosTest, OdometryFromTfDrivesTheShortLabRoute) {
+// Two of the node's alternative inputs in one drive (the suite's time): odometry from tf
+// rather than nav_msgs/Odometry, and the camera as jpeg sensor_msgs/CompressedImage on
+// image_raw/compressed (the raw topic remapped away) rather than sensor_msgs/Image.
+TEST_F(RosTest, TfOdometryAndCompressedImagesDriveTheShortLabRoute) {
   const std::string sketch = shortLabSketch(dir_);
-  sim_ = std::make_unique<Process>(cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1",
-                                        "--rate", "1", "odom:=odom_hidden"}),
-                                   (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
+  sim_ = std::make_unique<Process>(
+      cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1", "--rate", "1",
+           // (remapping matches whole names: image_raw/compressed stays)
+           "odom:=odom_hidden", "image_raw:=image_raw_hidden"}),
+      (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
   ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20)) << logs();
-  startNav(sketch, {"--max-time", "60", "--set", "ros.odom_source=tf", "--set", "ros.wait_s=20"});
+  startNav(sketch, {"--max-time", "60", "--set", "ros.odom_source=tf", "--set", "ros.wait_s=20",
+                    "--set", "ros.image_transport=compressed"});
   ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
   EXPECT_EQ(nav_->exitCode(), 0) << logs();
   const Json r = Json::parse(nav_->out());
@@ -1049,6 +1180,9 @@ TEST_F(RosTest, OdometryFromTfDrivesTheShortLabRoute) {
   EXPECT_GT(r["odom_path_m"].get<double>(), 2.0);
   // A topic source on the hidden topic would have waited for /odom and failed.
   EXPECT_EQ(nav_->err().find("no odometry message on /odom"), std::string::npos);
+  // L1 recognised in decoded jpeg frames; nothing else carried images.
+  EXPECT_NE(r["landmarks_recognised"].dump().find("L1"), std::string::npos) << r.dump(1);
+  EXPECT_GT(r["perception"]["frames"].get<int>(), 50) << r["perception"].dump();
 }
 
 // The launch files parse with roslaunch's own loader: the simulator + node pair on simulated
@@ -1087,6 +1221,7 @@ TEST(RosLaunch, LaunchFilesParse) {
   EXPECT_EQ(remap["cmd_vel"], "/RosAria/cmd_vel");
   EXPECT_EQ(remap["odom"], "/RosAria/pose");
   EXPECT_EQ(robot["params"]["/sketchnav_nav/ros/sonar_topic"], "");
+  EXPECT_EQ(robot["params"]["/sketchnav_nav/ros/image_transport"], "raw");
   // The settings the launch files set are settings the node takes (strict check).
   for (const Json* j : {&sim, &robot})
     for (const auto& [k, v] : (*j)["params"].items())
@@ -1113,7 +1248,11 @@ TEST(RosLaunch, LaunchFilesParse) {
 // robot publishing 640x480 frames at 10 Hz; the node's summary splits the latency into
 // transport (stamp -> callback), waiting for the executive's grab, and grab -> command (the
 // in-process path). A benchmark figure: the test checks only that it was measured.
-TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
+// ros.wake_on_frame on (the default) and off: the same robot, the latency printed for both.
+class RosLatency : public RosTest, public ::testing::WithParamInterface<bool> {};
+
+TEST_P(RosLatency, ImageToCommandLatencyIsMeasured) {
+  const bool wake = GetParam();
   auto img_pub = nh_->advertise<sensor_msgs::Image>("image_raw", 2);
   auto info_pub = nh_->advertise<sensor_msgs::CameraInfo>("camera_info", 2);
   auto odom_pub = nh_->advertise<nav_msgs::Odometry>("odom", 5);
@@ -1152,7 +1291,8 @@ TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
     }
   });
   startNav(shortLabSketch(dir_), {"--set", "ros.sonar_topic=", "--set", "ros.scan_topic=", "--set",
-                                  "ros.camera_mount_from_tf=false", "--max-time", "60"});
+                                  "ros.camera_mount_from_tf=false", "--max-time", "60", "--set",
+                                  std::string("ros.wake_on_frame=") + (wake ? "true" : "false")});
   const bool started = waitFor([&] { return !commands().empty() || !nav_->running(); }, 120);
   if (started && nav_->running()) std::this_thread::sleep_for(std::chrono::seconds(8));
   nav_->signal(SIGINT);
@@ -1167,19 +1307,30 @@ TEST_F(RosTest, ImageToCommandLatencyIsMeasured) {
   for (const char* k : {"transport", "convert", "wait", "grab_to_cmd", "total", "ros_overhead"})
     EXPECT_GE(L[k]["mean_ms"].get<double>(), 0.0) << k;
   EXPECT_GE(L["total"]["mean_ms"].get<double>(), L["grab_to_cmd"]["mean_ms"].get<double>());
+  // Frames woke the control loop, and only when asked to. (How many depends on the machine:
+  // a frame that arrives while perception runs finds the loop busy, not asleep.)
+  if (wake)
+    EXPECT_GT(L["frame_wakes"].get<int>(), 0) << L.dump(1);
+  else
+    EXPECT_EQ(L["frame_wakes"].get<int>(), 0) << L.dump(1);
   std::printf(
-      "latency over %d frames [ms, mean / p95]: transport %.2f / %.2f, convert %.2f / %.2f, "
+      "wake_on_frame %s, %d wakes; latency over %d frames [ms, mean / p95]: transport %.2f / %.2f, "
+      "convert %.2f / %.2f, "
       "wait %.2f / %.2f, grab->cmd %.2f / %.2f, total %.2f / %.2f, ROS overhead %.2f / %.2f\n",
-      L["frames"].get<int>(), L["transport"]["mean_ms"].get<double>(),
-      L["transport"]["p95_ms"].get<double>(), L["convert"]["mean_ms"].get<double>(),
-      L["convert"]["p95_ms"].get<double>(), L["wait"]["mean_ms"].get<double>(),
-      L["wait"]["p95_ms"].get<double>(), L["grab_to_cmd"]["mean_ms"].get<double>(),
-      L["grab_to_cmd"]["p95_ms"].get<double>(), L["total"]["mean_ms"].get<double>(),
-      L["total"]["p95_ms"].get<double>(), L["ros_overhead"]["mean_ms"].get<double>(),
-      L["ros_overhead"]["p95_ms"].get<double>());
+      wake ? "on" : "off", L["frame_wakes"].get<int>(), L["frames"].get<int>(),
+      L["transport"]["mean_ms"].get<double>(), L["transport"]["p95_ms"].get<double>(),
+      L["convert"]["mean_ms"].get<double>(), L["convert"]["p95_ms"].get<double>(),
+      L["wait"]["mean_ms"].get<double>(), L["wait"]["p95_ms"].get<double>(),
+      L["grab_to_cmd"]["mean_ms"].get<double>(), L["grab_to_cmd"]["p95_ms"].get<double>(),
+      L["total"]["mean_ms"].get<double>(), L["total"]["p95_ms"].get<double>(),
+      L["ros_overhead"]["mean_ms"].get<double>(), L["ros_overhead"]["p95_ms"].get<double>());
   RecordProperty("ros_overhead_mean_us",
                  static_cast<int>(L["ros_overhead"]["mean_ms"].get<double>() * 1000));
 }
+INSTANTIATE_TEST_SUITE_P(WakeOnFrame, RosLatency, ::testing::Bool(),
+                         [](const ::testing::TestParamInfo<bool>& i) {
+                           return std::string(i.param ? "on" : "off");
+                         });
 
 // A safety stop in server mode ends that route and keeps the robot still; only a new goal
 // moves it again. This process is the robot (wall time, 20 Hz), as in RosGarbage.

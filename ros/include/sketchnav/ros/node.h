@@ -3,6 +3,8 @@
 // to the master (ROS_MASTER_URI, ROS_IP as usual), and the ros:// devices registered by
 // registerDrivers() subscribe / publish through it:
 //   ros://camera?topic=image_raw&info=camera_info   sensor_msgs/Image (+ CameraInfo)
+//   ros://camera?topic=image_raw&transport=compressed  sensor_msgs/CompressedImage on
+//                                                      image_raw/compressed (+ CameraInfo)
 //   ros://base?cmd_vel=cmd_vel&odom=odom            geometry_msgs/Twist out, nav_msgs/Odometry in
 //   ros://base?cmd_vel=cmd_vel&tf=odom              ... odometry from tf odom -> base_link
 //   ros://laser?topic=scan                          sensor_msgs/LaserScan
@@ -33,6 +35,12 @@ struct RosParams {
   double wait_s = 30.0;          // [s, wall] how long opening a device waits for its first message
   double master_check_s = 0.25;  // [s, wall] how often the master's presence is checked
   std::string image_topic = "image_raw";
+  std::string image_transport = "raw";  // "raw": sensor_msgs/Image on image_topic;
+                                        // "compressed": sensor_msgs/CompressedImage (jpeg, png)
+                                        // on image_topic + "/compressed", decoded with OpenCV
+                                        // (image_transport's topic layout; also ~image_transport)
+  bool wake_on_frame = true;  // a new camera frame wakes the control loop at once instead of
+                              // waiting for its next tick (cuts the image -> command latency)
   std::string camera_info_topic = "camera_info";
   std::string odom_topic = "odom";
   std::string scan_topic = "scan";    // "" = no laser
@@ -42,14 +50,16 @@ struct RosParams {
   std::string odom_source = "topic";  // "topic": nav_msgs/Odometry on odom_topic; "tf": the
                                       // transform odom_frame -> base_frame (REP 105)
   std::string odom_frame = "odom";    // the odometry frame (tf source; pose, route, markers)
-  bool camera_mount_from_tf = true;  // servo.camera_x_m/z_m, nav.perception.camera_yaw/pitch
-                                     // from tf base_frame -> the image's frame, unless set
+  bool camera_mount_from_tf = true;   // servo.camera_x_m/z_m, nav.perception.camera_yaw/pitch
+                                      // from tf base_frame -> the image's frame, unless set
   template <class B>
   void bind(B& b) {
     b("stale_timeout_s", stale_timeout_s);
     b("wait_s", wait_s);
     b("master_check_s", master_check_s);
     b("image_topic", image_topic);
+    b("image_transport", image_transport);
+    b("wake_on_frame", wake_on_frame);
     b("camera_info_topic", camera_info_topic);
     b("odom_topic", odom_topic);
     b("scan_topic", scan_topic);
@@ -81,7 +91,7 @@ Config privateParams();
 
 /// Starts the watchdog with these limits (once; later calls update the limits).
 void startWatchdog(const RosParams& p);
-/// The latched fault ("" while healthy), e.g. "odometry on /odom: no message for 0.52 s".
+/// The latched fault ("" while healthy), e.g. "odometry on /odom: no usable message for 0.52 s".
 std::string fault();
 /// Publishes one zero Twist on the ros:// base's cmd_vel (no-op before the base exists): what
 /// the navigation sends when its route starts, so `ros sim` (holding time at 0) starts too.
@@ -96,6 +106,11 @@ void resetFault();
 /// sleepUntil() returns early once the watchdog has tripped, so a frozen /clock cannot hang
 /// the executive.
 std::shared_ptr<hw::Clock> clock();
+/// From now on the clock's sleepUntil() also returns as soon as the ros:// camera delivers a
+/// frame stamped at least `min_gap_s` after the last frame grabbed (the executive grabs one
+/// when nav.camera_period_s - tick_s / 2 has passed): the control loop runs that frame at
+/// once. A negative gap turns it off (frames wait for the next tick).
+void wakeOnFrames(double min_gap_s);
 /// Waits (wall) until ROS time is valid (a first /clock under use_sim_time). False on timeout.
 bool waitForTime(double timeout_s);
 
@@ -106,7 +121,8 @@ void noteObservation(std::uint64_t frame_seq);
 /// node's callback; null under simulated time, where stamps are not wall time), convert
 /// (the callback's checks and cv_bridge copy), wait (converted -> the executive's grab),
 /// grab_to_cmd (the in-process path: grab -> the command sent), total (stamp, or callback
-/// under simulated time, -> command) and ros_overhead (total - grab_to_cmd).
+/// under simulated time, -> command) and ros_overhead (total - grab_to_cmd); frame_wakes:
+/// how many times a frame woke the control loop early (wakeOnFrames()).
 Json latencySummary();
 
 /// Registers the ros:// camera, base and range drivers with hw::Registry. Idempotent.
@@ -123,7 +139,9 @@ struct CameraMount {
 bool lookupCameraMount(const std::string& base_frame, const std::string& camera_frame,
                        double timeout_s, CameraMount& out);
 /// The frame_id of the next image on `topic` (waiting up to timeout_s wall); "" on timeout.
-std::string imageFrame(const std::string& topic, double timeout_s);
+/// `transport` "compressed" reads sensor_msgs/CompressedImage on `topic`/compressed.
+std::string imageFrame(const std::string& topic, double timeout_s,
+                       const std::string& transport = "raw");
 
 /// A std_msgs/String topic carrying one JSON object per message (state, events, result).
 class JsonPublisher {
