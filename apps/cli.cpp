@@ -1,10 +1,14 @@
 #include "cli.h"
 
+#include <cerrno>
+#include <cmath>
 #include <cstdlib>
 #include <iostream>
+#include <limits>
 #include <sstream>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 
 namespace sketchnav::app {
 
@@ -98,20 +102,28 @@ bool Args::flagSet(const std::string& name) const {
 double Args::getDouble(const std::string& name) const {
   const std::string v = get(name);
   char* end = nullptr;
+  errno = 0;
   const double d = std::strtod(v.c_str(), &end);
-  if (v.empty() || *end != '\0')
-    throw InputError("sketchnav " + command_ + ": --" + name + " expects a number, got '" + v +
-                     "'");
+  // strtod also takes "nan", "inf" and overflows to HUGE_VAL: no option means any of them
+  // (`--max-time nan` ran with the default time before).
+  if (v.empty() || *end != '\0' || !std::isfinite(d) || errno == ERANGE)
+    throw InputError("sketchnav " + command_ + ": --" + name + " expects a finite number, got '" +
+                     clipForMessage(v) + "'");
   return d;
 }
 
 int Args::getInt(const std::string& name) const {
   const std::string v = get(name);
   char* end = nullptr;
+  errno = 0;
   const long d = std::strtol(v.c_str(), &end, 10);
-  if (v.empty() || *end != '\0')
-    throw InputError("sketchnav " + command_ + ": --" + name + " expects an integer, got '" + v +
-                     "'");
+  // Out of int's range is an error, not a wrapped value (4294967297 became 1).
+  if (v.empty() || *end != '\0' || errno == ERANGE || d < std::numeric_limits<int>::min() ||
+      d > std::numeric_limits<int>::max())
+    throw InputError("sketchnav " + command_ + ": --" + name + " expects an integer in [" +
+                     std::to_string(std::numeric_limits<int>::min()) + ", " +
+                     std::to_string(std::numeric_limits<int>::max()) + "], got '" +
+                     clipForMessage(v) + "'");
   return static_cast<int>(d);
 }
 

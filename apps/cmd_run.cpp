@@ -54,7 +54,11 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
     o.seed = v.get<int>();
   }
   o.realtime = args.flagSet("realtime");
-  if (!args.get("max-time").empty()) o.max_time_s = args.getDouble("max-time");
+  if (!args.get("max-time").empty()) {
+    o.max_time_s = args.getDouble("max-time");
+    // 0 or less was ignored (the run took nav.max_time_s without a word).
+    if (o.max_time_s <= 0) throw InputError("sketchnav run: --max-time must be > 0 s");
+  }
   o.robot = args.get("robot");
   o.camera = args.get("camera");
   o.laser = args.get("laser");

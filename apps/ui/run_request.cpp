@@ -2,19 +2,38 @@
 // the navigation stack (the fuzzer, fuzz/entry_webui.cpp, links only these).
 #include "run_request.h"
 
+#include <algorithm>
 #include <climits>
 #include <cmath>
 #include <cstdint>
 #include <regex>
+#include <vector>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 
 namespace sketchnav::ui {
 
 // ---- request -------------------------------------------------------------------------------
 
+namespace {
+// A field the request does not take is an error like an unknown setting: a misspelt "sede"
+// ran with seed 1 without a word.
+void requireKnownFields(const Json& j, const std::string& what,
+                        const std::vector<std::string>& known) {
+  for (auto it = j.begin(); it != j.end(); ++it) {
+    if (std::find(known.begin(), known.end(), it.key()) != known.end()) continue;
+    throw InputError(what + ": unknown field '" + clipForMessage(it.key()) + "' (did you mean '" +
+                     closestKey(it.key(), known) + "'?)");
+  }
+}
+}  // namespace
+
 RunRequest RunRequest::fromJson(const Json& j) {
   if (!j.is_object()) throw InputError("run request: expected a JSON object");
+  requireKnownFields(j, "run request",
+                     {"world", "sketch", "seed", "max_time_s", "mode", "robot", "camera", "laser",
+                      "sonar", "camera_only"});
   RunRequest r;
   auto str = [&](const char* key, std::string& out) {
     if (!j.contains(key) || j[key].is_null()) return;
@@ -32,10 +51,10 @@ RunRequest RunRequest::fromJson(const Json& j) {
   if (j.contains("seed")) {
     // Range-checked as a 64-bit value: get<int>() would wrap 4294967297 to seed 1.
     const Json& v = j["seed"];
-    const bool ok = v.is_number_unsigned()  ? v.get<std::uint64_t>() <= INT_MAX
-                    : v.is_number_integer() ? v.get<std::int64_t>() >= 0 &&
-                                                  v.get<std::int64_t>() <= INT_MAX
-                                            : false;
+    const bool ok = v.is_number_unsigned() ? v.get<std::uint64_t>() <= INT_MAX
+                    : v.is_number_integer()
+                        ? v.get<std::int64_t>() >= 0 && v.get<std::int64_t>() <= INT_MAX
+                        : false;
     if (!ok) throw InputError("run request: 'seed' must be an integer 0..2147483647");
     r.seed = v.get<int>();
   }
@@ -94,6 +113,8 @@ Json RunRequest::toJson() const {
 }
 
 CaptureRequest CaptureRequest::fromJson(const Json& j) {
+  if (!j.is_object()) throw InputError("capture: expected a JSON object");
+  requireKnownFields(j, "capture", {"class", "box"});
   if (!j.contains("class") || !j["class"].is_string())
     throw InputError("capture: 'class' (a landmark class name) is required");
   std::optional<cv::Rect> box;

@@ -3,6 +3,8 @@
 #include "sketchnav/core/json_io.h"
 
 #include <algorithm>
+#include <cmath>
+#include <cstdint>
 #include <fstream>
 #include <limits>
 #include <sstream>
@@ -13,9 +15,12 @@ void flatten(const Json& j, const std::string& prefix, const std::string& origin
              std::map<std::string, Json>& out, std::map<std::string, std::string>& origins) {
   for (auto it = j.begin(); it != j.end(); ++it) {
     const std::string key = prefix.empty() ? it.key() : prefix + "." + it.key();
-    if (it->is_object()) {
+    if (it->is_object() && !it->empty()) {
       flatten(*it, key, origin, out, origins);
     } else {
+      // An empty object sets nothing but names a key all the same: kept as a value, so a
+      // misspelt {"servo": {"lamda": {}}} is an unknown setting like any other (it was
+      // accepted without a word), and {} for a setting is a type error.
       out[key] = *it;
       origins[key] = origin;
     }
@@ -79,8 +84,16 @@ void Config::markKnown(const std::string& key) const {
 
 std::vector<std::string> Config::unusedKeys(const std::string& prefix) const {
   std::vector<std::string> out;
-  for (const auto& k : keys(prefix))
-    if (!usage_->used.count(k)) out.push_back(k);
+  for (const auto& k : keys(prefix)) {
+    if (usage_->used.count(k)) continue;
+    // An empty section of known settings ({"nav": {}}) is not a setting of its own.
+    const Json& v = values_.at(k);
+    if (v.is_object() && v.empty()) {
+      const auto below = usage_->known.lower_bound(k + ".");
+      if (below != usage_->known.end() && below->rfind(k + ".", 0) == 0) continue;
+    }
+    out.push_back(k);
+  }
   return out;
 }
 
@@ -154,6 +167,21 @@ Json Config::toJson() const {
   }
   return out;
 }
+
+namespace detail {
+bool wholeNumberWithin(const Json& v, long double lo, long double hi) {
+  long double x = 0;
+  if (v.is_number_unsigned())
+    x = static_cast<long double>(v.get<std::uint64_t>());
+  else if (v.is_number_integer())
+    x = static_cast<long double>(v.get<std::int64_t>());
+  else if (v.is_number_float())
+    x = static_cast<long double>(v.get<double>());
+  else
+    return false;
+  return std::isfinite(x) && x == std::floor(x) && x >= lo && x <= hi;
+}
+}  // namespace detail
 
 void require(bool ok, const std::string& field, const std::string& why) {
   if (!ok) throw InputError("invalid setting '" + field + "': " + why);

@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <cstdint>
 #include <fstream>
 
 #include "sketchnav/core/config.h"
@@ -164,6 +165,77 @@ TEST(Config, NoSuggestionWhenNothingIsKnown) {
               std::string::npos)
         << e.what();
   }
+}
+
+// An empty object sets nothing, but a misspelt key holding one was accepted without a word
+// (issue 28: 0 silent accepts of unknown keys in --config).
+TEST(Config, AnEmptyObjectUnderAnUnknownKeyIsRefusedLikeAnyUnknownSetting) {
+  const auto refusal = [](const Json& j, const std::vector<std::string>& deferred = {}) {
+    Config c = Config::fromJson(j, "my.json");
+    DemoParams p;
+    try {
+      applyConfig(p, c, "demo");
+      if (deferred.empty())
+        c.requireAllUsed();
+      else
+        c.requireAllUsedExcept(deferred);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refusal(Json::parse(R"({"demo": {"lamda": {}}})")),
+            "my.json: unknown setting 'demo.lamda' (did you mean 'demo.lambda'?)");
+  EXPECT_EQ(refusal(Json::parse(R"({"dmeo": {}})")),
+            "my.json: unknown setting 'dmeo' (did you mean 'demo.name'?)");
+  EXPECT_EQ(refusal(Json::parse(R"({"demo": {"lambda": {}}})")),
+            "my.json: setting 'demo.lambda' has the wrong type (got {})");
+  // A section of known settings may be empty; a deferred one is checked later.
+  EXPECT_EQ(refusal(Json::parse(R"({"demo": {}})")), "");
+  EXPECT_EQ(refusal(Json::parse(R"({"camera": {"folder": {}}})"), {"camera."}), "");
+  EXPECT_NE(refusal(Json::parse(R"({"camera": {"folder": {}}})")), "");
+}
+
+// Integer settings take whole numbers in their type's range only (issue 28: `--set
+// sim.seed=-1` ran with seed 18446744073709551615).
+struct IntegerParams {
+  std::uint64_t seed = 1;  // a seed
+  int count = 1;           // a count
+  template <class B>
+  void bind(B& b) {
+    b("seed", seed);
+    b("count", count);
+  }
+  void validate() const {}
+};
+
+TEST(Config, IntegerSettingsRefuseNegativeFractionalAndOutOfRangeNumbers) {
+  using P = IntegerParams;
+  const auto apply = [](const std::string& assignment) {
+    Config c;
+    c.set(assignment);
+    P p;
+    try {
+      applyConfig(p, c, "p");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string("taken: seed ") + std::to_string(p.seed) + ", count " +
+           std::to_string(p.count);
+  };
+  EXPECT_EQ(apply("p.seed=-1"),
+            "--set p.seed: setting 'p.seed' must be a whole number in [0, 18446744073709551615] "
+            "(got -1)");
+  EXPECT_EQ(apply("p.count=4294967297"),
+            "--set p.count: setting 'p.count' must be a whole number in [-2147483648, "
+            "2147483647] (got 4294967297)");
+  EXPECT_EQ(apply("p.count=2.7"),
+            "--set p.count: setting 'p.count' must be a whole number in [-2147483648, "
+            "2147483647] (got 2.7)");
+  EXPECT_EQ(apply("p.seed=18446744073709551615"), "taken: seed 18446744073709551615, count 1");
+  EXPECT_EQ(apply("p.count=-3"), "taken: seed 1, count -3");
+  EXPECT_EQ(apply("p.count=1e3"), "taken: seed 1, count 1000");
+  EXPECT_NE(apply("p.count=\"7\"").find("has the wrong type"), std::string::npos);
 }
 
 TEST(Config, CopiesShareTheUsageRecord) {

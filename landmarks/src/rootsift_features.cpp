@@ -8,6 +8,21 @@
 
 namespace sketchnav::landmarks {
 
+namespace {
+// cv::resize by `scale` (INTER_AREA), but never to 0 px: a 1 x 4000 photo scaled down rounds to
+// 0 px wide, which cv::resize refuses with an assertion (issue 28: `recognise` exit 1). Other
+// images take exactly the scale-factor call as before (same pixels, same features).
+void resizeAtLeastOnePixel(const cv::Mat& src, cv::Mat& dst, double scale) {
+  const cv::Size to(cv::saturate_cast<int>(src.cols * scale),
+                    cv::saturate_cast<int>(src.rows * scale));
+  if (to.width >= 1 && to.height >= 1)
+    cv::resize(src, dst, cv::Size(), scale, scale, cv::INTER_AREA);
+  else
+    cv::resize(src, dst, cv::Size(std::max(1, to.width), std::max(1, to.height)), 0, 0,
+               cv::INTER_AREA);
+}
+}  // namespace
+
 void FeatureParams::validate() const {
   require(max_features >= 0, "features.max_features", "must be >= 0");
   require(max_image_side >= 64, "features.max_image_side", "must be >= 64 px");
@@ -52,7 +67,7 @@ void detectSift(const cv::Mat& image, const FeatureParams& p, std::vector<cv::Ke
   double scale = 1.0;
   if (side > p.max_image_side) {
     scale = static_cast<double>(p.max_image_side) / side;
-    cv::resize(grey, grey, cv::Size(), scale, scale, cv::INTER_AREA);
+    resizeAtLeastOnePixel(grey, grey, scale);
   }
   // One detector per thread: cv::SIFT is cheap to create but not documented as re-entrant.
   thread_local cv::Ptr<cv::SIFT> sift;
@@ -92,7 +107,7 @@ cv::Mat keypointColours(const cv::Mat& image, const std::vector<cv::KeyPoint>& k
   const double s = std::min(1.0, static_cast<double>(kSide) / std::max(bgr.cols, bgr.rows));
   cv::Mat small;
   if (s < 1)
-    cv::resize(bgr, small, cv::Size(), s, s, cv::INTER_AREA);
+    resizeAtLeastOnePixel(bgr, small, s);
   else
     small = bgr;
   cv::Mat integ;

@@ -431,6 +431,36 @@ TEST(RunRequest, CameraOnlyNeedsOnlyACamera) {
   EXPECT_DOUBLE_EQ(sim.max_time_s, 30);
 }
 
+// Issue 28: a field the request does not take is refused like an unknown setting (a misspelt
+// "sede" started a run with seed 1).
+TEST(RunRequest, UnknownFieldsAreRefusedNamingTheClosestKnownOne) {
+  const auto refusal = [](const Json& j, bool capture) {
+    try {
+      if (capture)
+        ui::CaptureRequest::fromJson(j);
+      else
+        ui::RunRequest::fromJson(j);
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+    return std::string();
+  };
+  EXPECT_EQ(refusal({{"world", "lab"}, {"sede", 3}}, false),
+            "run request: unknown field 'sede' (did you mean 'seed'?)");
+  EXPECT_EQ(refusal({{"class", "Oatly-Oat-Milk"}, {"bx", {0, 0, 10, 10}}}, true),
+            "capture: unknown field 'bx' (did you mean 'box'?)");
+  // What the pages send is taken (share/web/run.js and app.js).
+  EXPECT_EQ(
+      refusal(
+          {{"mode", "sim"}, {"max_time_s", 0}, {"world", "corridor"}, {"sketch", ""}, {"seed", 1}},
+          false),
+      "");
+  EXPECT_EQ(refusal({{"mode", "camera"}, {"camera_only", true}, {"camera", "video://0"}}, false),
+            "");
+  EXPECT_EQ(refusal(ui::RunRequest::fromJson({{"world", "lab"}}).toJson(), false), "");
+  EXPECT_EQ(refusal({{"class", "Oatly-Oat-Milk"}, {"box", {0, 0, 10, 10}}}, true), "");
+}
+
 TEST(SafeClassName, AcceptsFolderNamesOfTheLandmarkSet) {
   EXPECT_EQ(ui::safeClassName("Oatly-Oat-Milk"), "Oatly-Oat-Milk");
   EXPECT_EQ(ui::safeClassName("Red Mug 2"), "Red Mug 2");

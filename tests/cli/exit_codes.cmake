@@ -71,3 +71,12 @@ expect(2 "camera URI 'folder:///x\\?fsp=10': unknown parameter 'fsp' \\(did you 
        probe folder:///x?fsp=10)
 expect(2 "camera URI 'sim://lab\\?sed=3': unknown parameter 'sed' \\(did you mean 'seed'\\?\\)"
        probe sim://lab?sed=3)
+# Numbers that are no number of the kind asked (issue 28): `--max-time nan` ran with the default
+# time, `--set sim.seed=-1` with seed 18446744073709551615, an int option of 2^32+1 as 1.
+expect(2 "sketchnav run: --max-time expects a finite number, got 'nan'" run --max-time nan --out ${WORK}/r-nan)
+expect(2 "sketchnav run: --max-time expects a finite number, got 'inf'" run --max-time inf --out ${WORK}/r-inf)
+expect(2 "sketchnav run: --max-time must be > 0 s" run --max-time 0 --out ${WORK}/r-zero)
+expect(2 "--set sim.seed: setting 'sim.seed' must be a whole number in \\[0, 18446744073709551615\\] \\(got -1\\)"
+       sim drive --world corridor --seconds 0.5 --camera-hz 0 --set sim.seed=-1 --out ${WORK}/d-seed)
+expect(2 "sketchnav sim drive: --seed expects an integer in \\[-2147483648, 2147483647\\], got '4294967297'"
+       sim drive --world corridor --seconds 0.5 --camera-hz 0 --seed 4294967297 --out ${WORK}/d-seed2)

@@ -89,6 +89,11 @@ expect(2 "--annotate is for IMAGE" recognise --model ${WORK}/demo.slm --eval ${W
 run_ok(out err --json recognise --model ${WORK}/demo.slm --frame 640x480
        ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_1x4000.png
        ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_4000x1.png)
+# The same photos as they are (no --frame): the feature and colour reductions rounded them to
+# 0 px (the same assertion, exit 1).
+run_ok(out err --json recognise --model ${WORK}/demo.slm
+       ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_1x4000.png
+       ${CMAKE_CURRENT_LIST_DIR}/fixtures/thin_4000x1.png)
 # Image inputs (issue 28): one bad IMAGE is exit 2 naming it (a FIFO blocked for ever, a header
 # declaring 30000 x 30000 pixels decoded to gigabytes); among several it is skipped with a
 # warning that says why and the others are answered.

@@ -14,11 +14,13 @@
 #include <filesystem>
 #include <fstream>
 #include <functional>
+#include <random>
 #include <sstream>
 #include <thread>
 
 #include "child_process.h"
 #include "sketchnav/drivers/rawlog.h"
+#include "sketchnav/drivers/recording.h"
 #include "test_data.h"
 
 namespace fs = std::filesystem;
@@ -111,9 +113,10 @@ struct Outcome {
 
 // Starts `sketchnav run`, kills it with SIGKILL as soon as `moment_reached(out)` holds, and
 // checks every file in its folder.
+// With `before_outputs_ok` the moment may come before the run has opened its outputs.
 Outcome killAndCheck(const std::string& out, const std::string& max_time,
                      const std::function<bool(const std::string&)>& moment_reached,
-                     const std::string& name) {
+                     const std::string& name, bool before_outputs_ok = false) {
   fs::remove_all(out);
   fs::create_directories(out);
   sketchnav::test::ChildProcess run({SKETCHNAV_EXE, "--log-file", out + "/run.log", "run",
@@ -139,14 +142,26 @@ Outcome killAndCheck(const std::string& out, const std::string& max_time,
       name + " (killed at " + std::to_string(sizeOf(out + "/telemetry.csv")) + " bytes)";
   const std::string tele = out + "/telemetry.csv";
   if (!fs::exists(tele)) {
-    ADD_FAILURE() << moment << ": no telemetry.csv";
+    // Killed before the run opened its outputs (settings, world, model): nothing is written
+    // yet but the log. A moment chosen by the outputs themselves must find them.
+    if (!before_outputs_ok) ADD_FAILURE() << moment << ": no telemetry.csv";
+    if (fs::exists(out + "/run.log")) checkLog(out + "/run.log", moment);
+    if (fs::exists(out + "/events.jsonl")) checkEvents(out + "/events.jsonl", moment);
     return r;
   }
   r.rows = checkTelemetry(tele, moment);
   EXPECT_TRUE(fs::exists(out + "/events.jsonl")) << moment;
   r.events = checkEvents(out + "/events.jsonl", moment);
   checkLog(out + "/run.log", moment);
-  r.records = checkRawlog(out + "/run.rawlog", moment);
+  if (fs::exists(out + "/run.rawlog")) r.records = checkRawlog(out + "/run.rawlog", moment);
+  // The run info beside the rawlog (what a replay runs with): whole JSON or absent.
+  if (fs::exists(out + "/run.rawlog.run.json")) {
+    try {
+      EXPECT_TRUE(sketchnav::drivers::readRunInfo(out + "/run.rawlog").is_object()) << moment;
+    } catch (const std::exception& e) {
+      ADD_FAILURE() << moment << ": run.rawlog.run.json: " << e.what();
+    }
+  }
   if (fs::exists(out + "/summary.json")) {
     r.summary = true;
     const auto j = nlohmann::json::parse(slurp(out + "/summary.json"), nullptr, false);
@@ -202,4 +217,31 @@ TEST(RunKill, SummaryAndTrajectoryAreWholeOrAbsentAfterSigkillAsTheRunEnds) {
     EXPECT_GT(r.rows, 10) << name;
     if (name == "trajectory.png") EXPECT_TRUE(r.summary) << "summary.json comes first";
   }
+}
+
+TEST(RunKill, EveryOutputIsWholeRecordsAfterSigkillAtRandomMoments) {
+  // Moments not chosen by what the files hold: a seeded uniform time after the start, over
+  // the whole life of a recording run (settings and world, the model, driving, the end's
+  // summary and picture). 2-second runs end within a few seconds of wall time here, so the
+  // window covers their end too; a kill after the exit checks nothing (counted).
+  const std::string base = sketchnav::test::tempDir("run-kill-random");
+  std::mt19937 rng(28);
+  std::uniform_real_distribution<double> at_s(0.05, 6.0);
+  int checked = 0, with_rows = 0;
+  for (int i = 0; i < 8; ++i) {
+    const double t = at_s(rng);
+    const std::string max_time = i % 2 ? "2" : "120";
+    const auto t0 = std::chrono::steady_clock::now();
+    const auto deadline = t0 + std::chrono::microseconds(static_cast<long>(t * 1e6));
+    const Outcome r = killAndCheck(
+        base + "/r" + std::to_string(i), max_time,
+        [deadline](const std::string&) { return std::chrono::steady_clock::now() >= deadline; },
+        "random kill " + std::to_string(i) + " at " + std::to_string(t) + " s of a " + max_time +
+            " s run",
+        /*before_outputs_ok=*/true);
+    if (!r.exited) ++checked;
+    if (r.rows > 0) ++with_rows;
+  }
+  EXPECT_GE(checked, 6) << "most kills must land while the run is alive";
+  EXPECT_GE(with_rows, 3) << "too few kills landed after the run began writing";
 }

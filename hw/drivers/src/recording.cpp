@@ -2,11 +2,11 @@
 
 #include <atomic>
 #include <filesystem>
-#include <fstream>
 #include <map>
 #include <mutex>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/input_file.h"
 #include "sketchnav/core/json_io.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/hw/forwarding.h"
@@ -25,12 +25,10 @@ class RawlogSink final : public Recorder {
   void addCommand(double v, double w, double stamp, bool stop) override {
     r_->addCommand(v, w, stamp, stop ? "CMD_STOP" : "CMD_VEL");
   }
-  // Beside the log, as its images are: MRPT's observation types have no place for it.
+  // Beside the log, as its images are: MRPT's observation types have no place for it. Whole
+  // or absent after kill -9 (a replay refuses a half-written file): temp file + rename.
   void addRunInfo(const Json& settings) override {
-    const std::string p = r_->path() + ".run.json";
-    std::ofstream out(p, std::ios::trunc);
-    out << settings.dump(1) << "\n";
-    if (!out.flush()) throw RuntimeError(p + ": cannot be written");
+    writeFileAtomically(r_->path() + ".run.json", settings.dump(1) + "\n", "run info");
   }
   std::string path() const override { return r_->path(); }
 

@@ -10,10 +10,12 @@
 // a setting the command does not use into an error naming the closest known key.
 #include <nlohmann/json.hpp>
 
+#include <limits>
 #include <map>
 #include <memory>
 #include <set>
 #include <string>
+#include <type_traits>
 #include <vector>
 
 #include "sketchnav/core/error.h"
@@ -73,8 +75,21 @@ class Config {
 std::string closestKey(const std::string& key, const std::vector<std::string>& candidates);
 
 namespace detail {
+/// True when `v` is a whole number within [lo, hi] (an integer, or a float with no fraction).
+bool wholeNumberWithin(const Json& v, long double lo, long double hi);
+
 template <class T>
 void assignFromJson(T& field, const Json& v, const std::string& key, const std::string& origin) {
+  if constexpr (std::is_integral_v<T> && !std::is_same_v<T, bool>) {
+    // The JSON library converts any number to any integer type: -1 became 18446744073709551615
+    // in sim.seed, 2.7 became 2 and 4294967297 became 1 in an int.
+    if (v.is_number() &&
+        !wholeNumberWithin(v, static_cast<long double>(std::numeric_limits<T>::min()),
+                           static_cast<long double>(std::numeric_limits<T>::max())))
+      throw InputError(origin + ": setting '" + key + "' must be a whole number in [" +
+                       std::to_string(std::numeric_limits<T>::min()) + ", " +
+                       std::to_string(std::numeric_limits<T>::max()) + "] (got " + v.dump() + ")");
+  }
   try {
     field = v.get<T>();
   } catch (const std::exception&) {
