@@ -184,7 +184,7 @@ struct FinalLookEnd {
   bool seen = false;
 };
 /// Turning on the spot to look for the attended landmark, never seen, that the sketch puts
-/// outside the camera's view (ExecutiveParams::side_look_*).
+/// outside the camera's view (SideLookParams, behaviours.h).
 struct SideLookStart {
   std::string id;
   int section = 0;

@@ -1,6 +1,7 @@
 #pragma once
 // Whether the robot is still making progress (the role of Nav2's nav2_core::ProgressChecker):
-// the executive's stuck test, which starts a recovery (ExecutiveParams::stuck_s, stuck_m).
+// the executive's stuck test, which starts a recovery (RecoverParams::stuck_s, stuck_m;
+// Recovery in behaviours.h).
 #include "sketchnav/hw/types.h"
 
 namespace sketchnav::nav {

@@ -1,0 +1,262 @@
+#pragma once
+// The executive's behaviours that are small enough to stand alone: following the route (and
+// looking towards an expected landmark on the way), looking to the side, the final look at
+// the goal, and the stuck recovery. Each has its own Params (keys directly under "nav.":
+// ExecutiveParams derives from them) and reports what it did as an outcome — the command it
+// proposes (CommandArbiter decides), the event to report — and never touches the devices, the
+// run's status or the route.
+#include <optional>
+#include <set>
+#include <utility>
+#include <vector>
+
+#include "sketchnav/hw/types.h"
+#include "sketchnav/nav/command_arbiter.h"
+#include "sketchnav/nav/events.h"
+#include "sketchnav/nav/landmark_tracker.h"
+#include "sketchnav/nav/sections.h"
+
+namespace sketchnav::nav {
+
+/// How the robot heads for a bearing (following, looking, docking, detouring).
+struct DriveParams {
+  double v_cruise = 0.30;         // [m/s] forward speed along the route
+  double k_heading = 1.2;         // [1/s] path following: yaw rate per rad of bearing error
+  double max_w = 0.8;             // [rad/s]
+  double turn_in_place_deg = 60;  // [deg] bearing error above which the robot turns on the spot
+  template <class B>
+  void bind(B& b) {
+    b("v_cruise", v_cruise);
+    b("k_heading", k_heading);
+    b("max_w", max_w);
+    b("turn_in_place_deg", turn_in_place_deg);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+/// The turn a signed bearing or yaw rate stands for (|x| < 0.05: Straight).
+servo::Turn turnOf(double x);
+/// Heading for a robot-frame bearing [rad]: yaw rate proportional to it (clamped to max_w);
+/// forward speed slowed by its cosine (times `scale`), and zero above turn_in_place_deg (turn
+/// on the spot first). The command's turn is left Straight: callers say what it stands for.
+Command headFor(double bearing, double scale, const DriveParams& p);
+
+/// Looking for a landmark on the way: the camera sees +-30 deg and a 0.4 m sign is recognised
+/// out to ~3 m, so a landmark sketched beside the path is only in view for a moment. While one
+/// is expected within look_range_m and not yet seen, the heading is kept within
+/// look_bearing_deg of where the sketch puts it (the robot turns towards it, as the paper's
+/// robot does). It never turns back for one: beyond look_max_bearing_deg the landmark is left
+/// to the miss test (a robot turning round for a landmark behind it livelocks against
+/// obstacles).
+struct LookParams {
+  double look_range_m = 5.0;         // [m]
+  double look_bearing_deg = 10;      // [deg]
+  double look_max_bearing_deg = 60;  // [deg]
+  template <class B>
+  void bind(B& b) {
+    b("look_range_m", look_range_m);
+    b("look_bearing_deg", look_bearing_deg);
+    b("look_max_bearing_deg", look_max_bearing_deg);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+/// Following the route (pure pursuit on the look-ahead point), or looking (the same, with the
+/// heading held towards an expected landmark not yet seen).
+class FollowBehaviour {
+ public:
+  FollowBehaviour(DriveParams drive, LookParams look, double approach_m)
+      : drive_(drive), look_(look), approach_m_(approach_m) {}
+  struct Proposal {
+    Behaviour behaviour = Behaviour::Follow;  // Follow, or Look when the heading was held
+    double target_bearing = 0;                // [rad] robot frame: what it steers to
+    Command command;
+  };
+  /// `lookahead_bearing` [rad]: the route's look-ahead point; `unseen`: where the sketch puts
+  /// the attended landmark when it is pending (not being tracked), else null. A landmark
+  /// within approach_m [m] is not looked for (it is being passed).
+  Proposal propose(double lookahead_bearing, const Polar* unseen) const;
+
+ private:
+  DriveParams drive_;
+  LookParams look_;
+  double approach_m_;
+};
+
+/// Looking to the side: a landmark the look above cannot keep in view (the sketch puts it
+/// beyond look_max_bearing_deg, or the robot is already abreast of it, or dodging turned it
+/// away) would pass unseen. When the attended landmark has never been seen, its predicted
+/// bearing (odometry + sketch) is outside the camera's field of view minus
+/// side_look_margin_deg, and it is between side_look_min_range_m and side_look_range_m away,
+/// the robot stops and turns on the spot towards it (events side_look_start / _end) until it
+/// is recognised (the servo then takes over) or for at most side_look_s, then resumes
+/// following. Once per landmark; none beyond side_look_max_bearing_deg (a landmark behind is
+/// left to the miss test, as above). side_look_s = 0: off.
+struct SideLookParams {
+  double side_look_s = 4.0;                // [s] time budget per landmark
+  double side_look_range_m = 4.0;          // [m] predicted range within which it is tried
+  double side_look_min_range_m = 0.5;      // [m] closer than this its bearing means little
+  double side_look_margin_deg = 5;         // [deg] inside the half field of view
+  double side_look_max_bearing_deg = 110;  // [deg] angle budget: furthest the robot turns
+  template <class B>
+  void bind(B& b) {
+    b("side_look_s", side_look_s);
+    b("side_look_range_m", side_look_range_m);
+    b("side_look_min_range_m", side_look_min_range_m);
+    b("side_look_margin_deg", side_look_margin_deg);
+    b("side_look_max_bearing_deg", side_look_max_bearing_deg);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+class SideLook {
+ public:
+  /// `half_fov_rad`: the camera's half horizontal field of view (0 without a camera: then no
+  /// look ever starts, see update()); `k_heading` [1/s], `max_w` [rad/s]: the turn.
+  SideLook(SideLookParams p, double half_fov_rad, double k_heading, double max_w)
+      : p_(p), half_fov_(half_fov_rad), k_heading_(k_heading), max_w_(max_w) {}
+
+  struct Outcome {
+    std::optional<event::SideLookStart> started;
+    std::optional<event::SideLookEnd> ended;  // the stuck clock restarts (standing still to look
+                                              // is not being stuck)
+    std::optional<Command> command;           // a turn on the spot towards the landmark
+  };
+  /// One tick at `now` [s]. `a`: the first attended landmark (null when none). A look starts
+  /// (when `can_look`: a camera) for a never-seen pending landmark predicted out of view, and
+  /// ends when it is seen, is no longer the attended one, the final look runs, the budget is
+  /// spent or it is beyond the angle budget. No look starts while `busy` (docking,
+  /// recovering); while `give_way` (dodging something that comes towards the robot) the dodge
+  /// drives, the clock still runs.
+  Outcome update(const LandmarkTracker& landmarks, const AttendedLandmark* a, double now,
+                 bool can_look, bool busy, bool final_looking, bool give_way);
+  bool active() const { return active_; }
+
+ private:
+  SideLookParams p_;
+  double half_fov_, k_heading_, max_w_;
+  bool active_ = false;
+  int k_ = -1, i_ = -1;                   // the landmark looked for
+  double t0_ = 0;                         // [s] since when
+  std::set<std::pair<int, int>> looked_;  // once per landmark
+};
+
+/// At the goal, a landmark never seen (too far on the way, or out of view) that the sketch puts
+/// within final_look_range_m: turn to it and look for up to final_look_s before arriving;
+/// seen, it is passed and the refit moves the goal. The goal is often extrapolated metres past
+/// the last landmark seen, and a missed last landmark was the commonest way to stop 0.5-0.8 m
+/// short. 0 = off.
+struct FinalLookParams {
+  double final_look_range_m = 4.0;  // [m]
+  double final_look_s = 5.0;        // [s]
+  bool final_look_fovea = true;     // hand the expected bearing to perception (foveal look)
+  template <class B>
+  void bind(B& b) {
+    b("final_look_range_m", final_look_range_m);
+    b("final_look_s", final_look_s);
+    b("final_look_fovea", final_look_fovea);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+class FinalLook {
+ public:
+  /// `k_heading` [1/s]: the turn towards the landmark.
+  FinalLook(FinalLookParams p, double k_heading) : p_(p), k_heading_(k_heading) {}
+
+  /// Whether a look was started and is not over (the landmark it looks for: target()).
+  bool underWay() const { return k_ >= 0 && !done_; }
+  /// Over (ended, or nothing to look for): no look is started again.
+  bool done() const { return done_; }
+  /// Whether (k, i) is the landmark of a look under way (kept out of the normal attention).
+  bool isTarget(int k, int i) const { return !done_ && k == k_ && i == i_; }
+  std::pair<int, int> target() const { return {k_, i_}; }
+
+  /// How a look ended, for the landmark looked for.
+  enum class Verdict {
+    None,  // not ended this call
+    Pass,  // it was seen: pass it (the fix moves the goal)
+    Miss,  // never seen: miss it (counts towards "lost")
+    Kept,  // never seen, and it had been missed on the way: missed as it was (counted then;
+           // this call has restored its state)
+  };
+  struct Outcome {
+    bool looking = false;  // the look goes on: hold the route open and turn
+    std::optional<event::FinalLookStart> started;
+    std::optional<event::FinalLookEnd> ended;
+    Verdict verdict = Verdict::None;
+  };
+  /// One tick at `now` [s], at the goal (or with a look under way). The first call chooses the
+  /// landmark (LandmarkTracker::finalLookCandidate: never seen, nearest within
+  /// final_look_range_m, `route` as placed now) and sets a missed one pending again; the look
+  /// ends when it has been seen on 3 frames (or passed) or after final_look_s. Nothing once
+  /// done(), after the route is finished, or with final_look_range_m = 0.
+  Outcome step(LandmarkTracker& landmarks, const SectionTracker& route, const hw::Pose2D& pose,
+               double now);
+  /// The turn on the spot towards robot-frame bearing `bearing` [rad] of the landmark (none
+  /// within 0.1 rad of it); the arbiter's result is clamped to max_w by the executive.
+  Command command(double bearing) const;
+
+ private:
+  FinalLookParams p_;
+  double k_heading_;
+  int k_ = -1, i_ = -1;
+  double t0_ = 0;
+  bool was_missed_ = false, done_ = false;
+};
+
+/// Stuck recovery: the reactive layers can livelock (boxed in between furniture, the route
+/// behind an obstacle the dodge went round the wrong way), turning on the spot. Not having moved
+/// stuck_m in stuck_s (ProgressChecker), the robot drives recover_m towards the most open
+/// direction (ties to the route side), then resumes.
+struct RecoverParams {
+  double stuck_s = 10;     // [s] not having moved stuck_m in this long (not docking): stuck
+  double stuck_m = 0.3;    // [m]
+  double recover_m = 1.0;  // [m] then drive this far towards the most open direction
+  double recover_s = 8;    // [s] (at most this long) and resume
+  template <class B>
+  void bind(B& b) {
+    b("stuck_s", stuck_s);
+    b("stuck_m", stuck_m);
+    b("recover_m", recover_m);
+    b("recover_s", recover_s);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+class Recovery {
+ public:
+  /// `k_heading` [1/s] (the avoider's), `max_w` [rad/s]: the turn to the escape heading.
+  Recovery(RecoverParams p, double k_heading, double max_w)
+      : p_(p), k_heading_(k_heading), max_w_(max_w) {}
+
+  /// The most open direction [rad, robot frame] from the range points `pts` (robot frame): of
+  /// 36 directions, the one whose corridor of half-width `half_width_m` is free furthest (up to
+  /// recover_m + 0.5, at least 0.5 m; `max_range_m`: the corridor test's reach), less 0.3 per
+  /// rad away from `route_bearing`. None when no direction is free for 0.5 m.
+  std::optional<double> openDirection(const std::vector<std::pair<double, double>>& pts,
+                                      double half_width_m, double max_range_m,
+                                      double route_bearing) const;
+  /// Starts driving towards robot-frame `direction` [rad] from `pose` at `now` [s].
+  event::RecoverStart start(double direction, const hw::Pose2D& pose, double now);
+  bool active() const { return active_; }
+  int count() const { return count_; }
+
+  struct Step {
+    Command command;
+    bool ended = false;  // driven recover_m, out of time, or blocked: over (report RecoverEnd)
+  };
+  /// One tick while active(): turn to the escape heading, then drive at `v_capped` [m/s] (the
+  /// recovery speed already capped by the clearance ahead). Ends it when over.
+  Step step(const hw::Pose2D& pose, double now, double v_capped);
+
+ private:
+  RecoverParams p_;
+  double k_heading_, max_w_;
+  bool active_ = false;
+  int count_ = 0;
+  double dir_ = 0, t0_ = 0;  // escape heading (odometry frame), start time
+  hw::Pose2D from_;
+};
+
+}  // namespace sketchnav::nav

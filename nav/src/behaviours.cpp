@@ -1,0 +1,204 @@
+#include "sketchnav/nav/behaviours.h"
+
+#include <algorithm>
+#include <cmath>
+
+#include "sketchnav/core/angles.h"
+#include "sketchnav/core/config.h"
+#include "sketchnav/nav/avoidance.h"
+
+namespace sketchnav::nav {
+
+void DriveParams::validate() const {
+  require(v_cruise > 0 && v_cruise <= 2, "nav.v_cruise", "must be in (0, 2] m/s");
+  require(k_heading > 0, "nav.k_heading", "must be > 0");
+  require(max_w > 0 && max_w <= 5, "nav.max_w", "must be in (0, 5] rad/s");
+  require(turn_in_place_deg > 0 && turn_in_place_deg <= 180, "nav.turn_in_place_deg",
+          "must be in (0, 180]");
+}
+
+void LookParams::validate() const {
+  require(look_range_m >= 0, "nav.look_range_m", "must be >= 0");
+  require(look_max_bearing_deg > 0 && look_max_bearing_deg <= 180, "nav.look_max_bearing_deg",
+          "must be in (0, 180]");
+  require(look_bearing_deg > 0 && look_bearing_deg <= 90, "nav.look_bearing_deg",
+          "must be in (0, 90]");
+}
+
+void SideLookParams::validate() const {
+  require(side_look_s >= 0, "nav.side_look_s", "must be >= 0 (0 = off)");
+  require(side_look_range_m > 0, "nav.side_look_range_m", "must be > 0");
+  require(side_look_min_range_m >= 0 && side_look_min_range_m < side_look_range_m,
+          "nav.side_look_min_range_m", "must be in [0, nav.side_look_range_m)");
+  require(side_look_margin_deg >= 0 && side_look_margin_deg < 90, "nav.side_look_margin_deg",
+          "must be in [0, 90)");
+  require(side_look_max_bearing_deg > 0 && side_look_max_bearing_deg <= 180,
+          "nav.side_look_max_bearing_deg", "must be in (0, 180]");
+}
+
+void FinalLookParams::validate() const {
+  require(final_look_range_m >= 0, "nav.final_look_range_m", "must be >= 0 (0 = off)");
+  require(final_look_s > 0, "nav.final_look_s", "must be > 0");
+}
+
+void RecoverParams::validate() const {
+  require(stuck_s > 0, "nav.stuck_s", "must be > 0");
+  require(stuck_m >= 0, "nav.stuck_m", "must be >= 0");
+  require(recover_m > 0, "nav.recover_m", "must be > 0");
+  require(recover_s > 0, "nav.recover_s", "must be > 0");
+}
+
+servo::Turn turnOf(double x) {
+  return std::abs(x) < 0.05 ? servo::Turn::Straight
+                            : (x > 0 ? servo::Turn::Left : servo::Turn::Right);
+}
+
+Command headFor(double bearing, double scale, const DriveParams& p) {
+  Command c;
+  c.w = std::clamp(p.k_heading * bearing, -p.max_w, p.max_w);
+  c.v = std::abs(bearing) > p.turn_in_place_deg * M_PI / 180
+            ? 0.0
+            : p.v_cruise * std::max(0.2, std::cos(bearing)) * scale;
+  return c;
+}
+
+FollowBehaviour::Proposal FollowBehaviour::propose(double lookahead_bearing,
+                                                   const Polar* unseen) const {
+  Proposal out;
+  out.target_bearing = lookahead_bearing;
+  bool looking = false;
+  // Not seen yet and near: keep it in view (LookParams).
+  if (unseen && unseen->range <= look_.look_range_m && unseen->range > approach_m_ &&
+      std::abs(unseen->bearing) <= look_.look_max_bearing_deg * M_PI / 180) {
+    const double m = look_.look_bearing_deg * M_PI / 180;
+    out.target_bearing = std::clamp(out.target_bearing, unseen->bearing - m, unseen->bearing + m);
+    looking = out.target_bearing != lookahead_bearing;
+  }
+  out.command = headFor(out.target_bearing, 1.0, drive_);
+  out.command.turn = turnOf(out.target_bearing);
+  out.behaviour = looking ? Behaviour::Look : Behaviour::Follow;
+  return out;
+}
+
+SideLook::Outcome SideLook::update(const LandmarkTracker& landmarks, const AttendedLandmark* a,
+                                   double now, bool can_look, bool busy, bool final_looking,
+                                   bool give_way) {
+  Outcome out;
+  const double max_b = p_.side_look_max_bearing_deg * M_PI / 180;
+  if (active_) {
+    const bool same = a && a->k == k_ && a->i == i_;
+    const bool seen = landmarks.track(k_, i_).frames_seen > 0;
+    if (seen || !same || final_looking || now - t0_ > p_.side_look_s ||
+        std::abs(a->pred.bearing) > max_b) {
+      active_ = false;
+      out.ended = event::SideLookEnd{landmarks.landmark(k_, i_).id, seen, now - t0_};
+    }
+  } else if (a && can_look && p_.side_look_s > 0 && !busy && !final_looking &&
+             !looked_.count({a->k, a->i})) {
+    const auto& t = landmarks.track(a->k, a->i);
+    const double b = std::abs(a->pred.bearing);
+    if (t.state == LandmarkState::Pending && t.frames_seen == 0 &&
+        b > half_fov_ - p_.side_look_margin_deg * M_PI / 180 && b <= max_b &&
+        a->pred.range <= p_.side_look_range_m && a->pred.range >= p_.side_look_min_range_m) {
+      active_ = true;
+      k_ = a->k;
+      i_ = a->i;
+      t0_ = now;
+      looked_.insert({a->k, a->i});
+      out.started = event::SideLookStart{landmarks.landmark(a->k, a->i).id, a->k,
+                                         a->pred.bearing * 180 / M_PI, a->pred.range};
+    }
+  }
+  if (active_ && !give_way) {
+    const double w = std::clamp(k_heading_ * a->pred.bearing, -max_w_, max_w_);
+    out.command = Command{0.0, w, turnOf(w)};
+  }
+  return out;
+}
+
+FinalLook::Outcome FinalLook::step(LandmarkTracker& landmarks, const SectionTracker& route,
+                                   const hw::Pose2D& pose, double now) {
+  Outcome out;
+  if (done_ || route.finished() || p_.final_look_range_m <= 0) return out;
+  if (k_ < 0) {
+    // Any section's: a landmark a few metres before the goal was often missed on the way (out
+    // of recognition range, or out of view) and is within range from the goal.
+    double at = 0;
+    const auto c = landmarks.finalLookCandidate(route, pose, p_.final_look_range_m, at);
+    if (!c) {
+      done_ = true;
+      return out;
+    }
+    k_ = c->first;
+    i_ = c->second;
+    t0_ = now;
+    was_missed_ = landmarks.track(k_, i_).state == LandmarkState::Missed;
+    landmarks.track(k_, i_).state = LandmarkState::Pending;  // a missed one is looked for again
+    out.started = event::FinalLookStart{landmarks.landmark(k_, i_).id, at};
+  }
+  const auto& t = landmarks.track(k_, i_);
+  const bool seen = t.frames_seen > 0;
+  // Seen: a few frames for its bearings to cross (the fix), then passed.
+  const bool enough = t.frames_seen >= 3 || t.state == LandmarkState::Passed;
+  if (enough || now - t0_ > p_.final_look_s) {
+    done_ = true;
+    out.ended = event::FinalLookEnd{landmarks.landmark(k_, i_).id, seen};
+    if (t.state == LandmarkState::Tracking || (t.state == LandmarkState::Pending && seen)) {
+      out.verdict = Verdict::Pass;
+    } else if (t.state == LandmarkState::Pending && was_missed_) {
+      landmarks.track(k_, i_).state = LandmarkState::Missed;  // as it was (counted then)
+      out.verdict = Verdict::Kept;
+    } else if (t.state == LandmarkState::Pending) {
+      out.verdict = Verdict::Miss;
+    }
+    return out;
+  }
+  out.looking = true;
+  return out;
+}
+
+Command FinalLook::command(double bearing) const {
+  const double w = std::abs(bearing) < 0.1 ? 0.0 : k_heading_ * bearing;
+  return {0.0, w, turnOf(w)};
+}
+
+std::optional<double> Recovery::openDirection(const std::vector<std::pair<double, double>>& pts,
+                                              double half_width_m, double max_range_m,
+                                              double route_bearing) const {
+  double best = -1e9, best_a = 0;
+  for (int i = 0; i < 36; ++i) {
+    const double a = wrapAngle(i * M_PI / 18);
+    const double free = corridorFree(pts, a, half_width_m, max_range_m);
+    const double score =
+        std::min(free, p_.recover_m + 0.5) - 0.3 * std::abs(wrapAngle(a - route_bearing));
+    if (free >= 0.5 && score > best) best = score, best_a = a;
+  }
+  if (best > -1e9) return best_a;
+  return std::nullopt;
+}
+
+event::RecoverStart Recovery::start(double direction, const hw::Pose2D& pose, double now) {
+  active_ = true;
+  ++count_;
+  dir_ = wrapAngle(pose.theta + direction);
+  t0_ = now;
+  from_ = pose;
+  return event::RecoverStart{direction * 180 / M_PI};
+}
+
+Recovery::Step Recovery::step(const hw::Pose2D& pose, double now, double v_capped) {
+  Step out;
+  const double a = wrapAngle(dir_ - pose.theta);
+  const double w = std::clamp(k_heading_ * a, -max_w_, max_w_);
+  const double v = std::abs(a) > 0.35 ? 0.0 : v_capped;
+  out.command = {v, w, turnOf(w)};
+  const bool blocked = std::abs(a) <= 0.35 && v <= 0;
+  if (std::hypot(pose.x - from_.x, pose.y - from_.y) >= p_.recover_m || now - t0_ > p_.recover_s ||
+      blocked) {
+    active_ = false;
+    out.ended = true;
+  }
+  return out;
+}
+
+}  // namespace sketchnav::nav

@@ -1,0 +1,277 @@
+// The executive's small behaviours on their own: heading for a bearing, following and looking,
+// looking to the side, the final look at the goal, and the stuck recovery.
+#include <gtest/gtest.h>
+
+#include <cmath>
+
+#include "route_util.h"
+#include "sketchnav/nav/behaviours.h"
+
+namespace sketchnav::nav {
+namespace {
+
+using mapsketch::Side;
+constexpr double kDeg = M_PI / 180;
+
+TEST(HeadFor, TurnsInPlaceAboveTheLimitAndSlowsWithTheBearing) {
+  DriveParams p;  // 0.3 m/s, 1.2 /s, 0.8 rad/s, 60 deg
+  Command c = headFor(0.0, 1.0, p);
+  EXPECT_DOUBLE_EQ(c.v, 0.3);
+  EXPECT_DOUBLE_EQ(c.w, 0.0);
+  c = headFor(0.5, 1.0, p);
+  EXPECT_NEAR(c.w, 0.6, 1e-12);
+  EXPECT_NEAR(c.v, 0.3 * std::cos(0.5), 1e-12);
+  c = headFor(-1.2, 0.5, p);  // over 60 deg: on the spot, yaw rate clamped
+  EXPECT_DOUBLE_EQ(c.v, 0.0);
+  EXPECT_DOUBLE_EQ(c.w, -0.8);
+  c = headFor(0.2, 0.5, p);  // scaled (docking's last metres)
+  EXPECT_NEAR(c.v, 0.15 * std::cos(0.2), 1e-12);
+  EXPECT_EQ(turnOf(0.04), servo::Turn::Straight);
+  EXPECT_EQ(turnOf(0.06), servo::Turn::Left);
+  EXPECT_EQ(turnOf(-0.06), servo::Turn::Right);
+}
+
+TEST(FollowBehaviour, HoldsTheHeadingTowardsANearUnseenLandmark) {
+  const FollowBehaviour f(DriveParams{}, LookParams{}, 1.4);
+  // Nothing expected: pure pursuit on the look-ahead point.
+  auto p = f.propose(0.3, nullptr);
+  EXPECT_EQ(p.behaviour, Behaviour::Follow);
+  EXPECT_DOUBLE_EQ(p.target_bearing, 0.3);
+  EXPECT_EQ(p.command.turn, servo::Turn::Left);
+  // A landmark 40 deg right, 3 m away, not seen: the heading is held within 10 deg of it.
+  const Polar right{-40 * kDeg, 3.0};
+  p = f.propose(0.0, &right);
+  EXPECT_EQ(p.behaviour, Behaviour::Look);
+  EXPECT_NEAR(p.target_bearing, -30 * kDeg, 1e-12);
+  EXPECT_EQ(p.command.turn, servo::Turn::Right);
+  EXPECT_NEAR(p.command.w, 1.2 * p.target_bearing, 1e-12);
+  // Already within 10 deg of it: following is looking enough.
+  EXPECT_EQ(f.propose(-35 * kDeg, &right).behaviour, Behaviour::Follow);
+  // Too far (look_range_m 5 m), being passed (approach_m), or behind (look_max_bearing_deg 60).
+  const Polar far{-40 * kDeg, 5.5}, close{-40 * kDeg, 1.2}, behind{-70 * kDeg, 3.0};
+  for (const Polar* q : {&far, &close, &behind}) {
+    p = f.propose(0.0, q);
+    EXPECT_EQ(p.behaviour, Behaviour::Follow);
+    EXPECT_DOUBLE_EQ(p.target_bearing, 0.0);
+  }
+}
+
+// One section along x, landmark A 2 m ahead and 2 m left (never seen), B further on.
+mapsketch::Route sideRoute() {
+  return test::makeRoute({{0, 0}, {10, 0}}, {{0, "A", "sign", {2, 2}, Side::Left},
+                                             {0, "B", "box", {6, -1}, Side::Right}});
+}
+
+TEST(SideLook, TurnsTowardsALandmarkOutOfViewUntilItIsSeen) {
+  const auto route = sideRoute();
+  LandmarkTracker lt(route, {});
+  SideLookParams p;  // 4 s, 0.5-4 m, 5 deg margin, 110 deg
+  SideLook look(p, 30 * kDeg, 1.2, 0.8);
+  const AttendedLandmark a{0, 0, {45 * kDeg, 2.8}, true};
+  // Busy (docking, recovering), no camera, or the final look running: no look starts.
+  EXPECT_FALSE(look.update(lt, &a, 1.0, true, true, false, false).started);
+  EXPECT_FALSE(look.update(lt, &a, 1.0, false, false, false, false).started);
+  EXPECT_FALSE(look.update(lt, &a, 1.0, true, false, true, false).started);
+  // In view (20 deg < 30 - 5): no need.
+  const AttendedLandmark in_view{0, 0, {20 * kDeg, 2.8}, true};
+  EXPECT_FALSE(look.update(lt, &in_view, 1.0, true, false, false, false).started);
+  auto o = look.update(lt, &a, 1.0, true, false, false, false);
+  ASSERT_TRUE(o.started.has_value());
+  EXPECT_EQ(o.started->id, "A");
+  EXPECT_NEAR(o.started->bearing_deg, 45, 1e-9);
+  ASSERT_TRUE(o.command.has_value());
+  EXPECT_DOUBLE_EQ(o.command->v, 0.0);
+  EXPECT_DOUBLE_EQ(o.command->w, 0.8);  // 1.2 x 0.785 clamped
+  EXPECT_TRUE(look.active());
+  // Dodging someone coming towards the robot: the dodge drives, the look goes on.
+  o = look.update(lt, &a, 1.5, true, false, false, true);
+  EXPECT_FALSE(o.command.has_value());
+  EXPECT_FALSE(o.ended.has_value());
+  // Recognised: over.
+  lt.track(0, 0).frames_seen = 1;
+  o = look.update(lt, &a, 2.0, true, false, false, false);
+  ASSERT_TRUE(o.ended.has_value());
+  EXPECT_TRUE(o.ended->seen);
+  EXPECT_NEAR(o.ended->duration_s, 1.0, 1e-12);
+  EXPECT_FALSE(o.command.has_value());
+  EXPECT_FALSE(look.active());
+}
+
+TEST(SideLook, OncePerLandmarkWithinItsBudget) {
+  const auto route = sideRoute();
+  LandmarkTracker lt(route, {});
+  SideLookParams p;
+  p.side_look_s = 2.0;
+  SideLook look(p, 30 * kDeg, 1.2, 0.8);
+  const AttendedLandmark a{0, 0, {60 * kDeg, 2.0}, true};
+  ASSERT_TRUE(look.update(lt, &a, 10.0, true, false, false, false).started);
+  EXPECT_FALSE(look.update(lt, &a, 12.0, true, false, false, false).ended) << "2 s: not over";
+  const auto o = look.update(lt, &a, 12.1, true, false, false, false);
+  ASSERT_TRUE(o.ended.has_value());
+  EXPECT_FALSE(o.ended->seen);
+  // Never again for A.
+  EXPECT_FALSE(look.update(lt, &a, 13.0, true, false, false, false).started);
+  // Beyond the angle budget (110 deg), too close or too far: none for B either.
+  for (const Polar q : {Polar{120 * kDeg, 2.0}, Polar{60 * kDeg, 0.4}, Polar{60 * kDeg, 4.5}}) {
+    const AttendedLandmark b{0, 1, q, true};
+    EXPECT_FALSE(look.update(lt, &b, 14.0, true, false, false, false).started);
+  }
+  // Another landmark attended while looking ends the look.
+  SideLook look2(p, 30 * kDeg, 1.2, 0.8);
+  const AttendedLandmark b{0, 1, {-50 * kDeg, 3.0}, true};
+  ASSERT_TRUE(look2.update(lt, &b, 20.0, true, false, false, false).started);
+  const auto moved_on = look2.update(lt, &a, 20.5, true, false, false, false);
+  ASSERT_TRUE(moved_on.ended.has_value());
+  EXPECT_EQ(moved_on.ended->id, "B");
+  EXPECT_FALSE(moved_on.started.has_value()) << "one thing per tick: A's look waits";
+}
+
+// The goal at (10, 0); C 2 m before it on the left, D behind the start.
+mapsketch::Route goalRoute() {
+  return test::makeRoute({{0, 0}, {10, 0}}, {{0, "D", "sign", {0.5, -1}, Side::Right},
+                                             {0, "C", "carton", {8, 1.5}, Side::Left}});
+}
+
+TEST(FinalLook, LooksForTheNearestLandmarkNeverSeenAndPassesItWhenSeen) {
+  const auto route = goalRoute();
+  SectionTracker sections(route);
+  LandmarkTracker lt(route, {});
+  lt.miss(0, 1);  // C was missed on the way
+  FinalLook fl(FinalLookParams{}, 1.2);
+  const hw::Pose2D at_goal{9.8, 0, 0};
+  auto o = fl.step(lt, sections, at_goal, 50.0);
+  ASSERT_TRUE(o.started.has_value());
+  EXPECT_EQ(o.started->id, "C");
+  EXPECT_NEAR(o.started->range_m, std::hypot(1.8, 1.5), 1e-9);
+  EXPECT_TRUE(o.looking);
+  EXPECT_TRUE(fl.underWay());
+  EXPECT_TRUE(fl.isTarget(0, 1));
+  EXPECT_EQ(lt.track(0, 1).state, LandmarkState::Pending) << "looked for again";
+  // Seen on 3 frames: over, pass it.
+  lt.track(0, 1).frames_seen = 2;
+  lt.track(0, 1).state = LandmarkState::Tracking;
+  EXPECT_TRUE(fl.step(lt, sections, at_goal, 51.0).looking);
+  lt.track(0, 1).frames_seen = 3;
+  o = fl.step(lt, sections, at_goal, 51.5);
+  EXPECT_FALSE(o.looking);
+  ASSERT_TRUE(o.ended.has_value());
+  EXPECT_TRUE(o.ended->seen);
+  EXPECT_EQ(o.verdict, FinalLook::Verdict::Pass);
+  EXPECT_TRUE(fl.done());
+  EXPECT_FALSE(fl.isTarget(0, 1));
+  // Done: never again.
+  o = fl.step(lt, sections, at_goal, 52.0);
+  EXPECT_FALSE(o.started || o.ended || o.looking);
+  // The turn towards it: none within 0.1 rad.
+  EXPECT_DOUBLE_EQ(fl.command(0.05).w, 0.0);
+  EXPECT_NEAR(fl.command(0.5).w, 0.6, 1e-12);
+  EXPECT_DOUBLE_EQ(fl.command(0.5).v, 0.0);
+}
+
+TEST(FinalLook, NotSeenInTimeTheLandmarkIsMissedOrStaysMissed) {
+  const auto route = goalRoute();
+  SectionTracker sections(route);
+  FinalLookParams p;
+  p.final_look_s = 5.0;
+  const hw::Pose2D at_goal{9.8, 0, 0};
+  for (bool missed_before : {false, true}) {
+    LandmarkTracker lt(route, {});
+    if (missed_before) lt.miss(0, 1);
+    FinalLook fl(p, 1.2);
+    ASSERT_TRUE(fl.step(lt, sections, at_goal, 10.0).started);
+    EXPECT_TRUE(fl.step(lt, sections, at_goal, 15.0).looking);
+    const auto o = fl.step(lt, sections, at_goal, 15.1);
+    ASSERT_TRUE(o.ended.has_value());
+    EXPECT_FALSE(o.ended->seen);
+    EXPECT_EQ(o.verdict, missed_before ? FinalLook::Verdict::Kept : FinalLook::Verdict::Miss);
+    EXPECT_EQ(lt.track(0, 1).state, missed_before ? LandmarkState::Missed : LandmarkState::Pending);
+  }
+  // Nothing within range (D is 9 m away, C seen already): done at once; off with range 0.
+  LandmarkTracker lt(route, {});
+  lt.track(0, 1).frames_seen = 4;
+  FinalLook fl(p, 1.2);
+  const auto o = fl.step(lt, sections, at_goal, 1.0);
+  EXPECT_FALSE(o.started || o.looking);
+  EXPECT_TRUE(fl.done());
+  p.final_look_range_m = 0;
+  LandmarkTracker lt2(route, {});
+  FinalLook off(p, 1.2);
+  EXPECT_FALSE(off.step(lt2, sections, at_goal, 1.0).started);
+}
+
+TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
+  RecoverParams p;  // 1 m, 8 s
+  Recovery r(p, 1.5, 0.8);
+  // A dead end (robot frame): a wall 0.45 m ahead, walls 0.4 m to either side running back
+  // 5 m. The route is ahead, but the only way out is straight back.
+  std::vector<std::pair<double, double>> dead_end;
+  for (double y = -0.4; y <= 0.4; y += 0.05) dead_end.push_back({0.45, y});
+  for (double x = -5; x <= 0.45; x += 0.05)
+    dead_end.push_back({x, 0.4}), dead_end.push_back({x, -0.4});
+  const auto dir = r.openDirection(dead_end, 0.3, 4.0, 0.0);
+  ASSERT_TRUE(dir.has_value());
+  EXPECT_NEAR(std::abs(*dir), M_PI, 1e-9);
+  // Open to the left as well (no left wall): left is nearer the route's side and wins.
+  std::vector<std::pair<double, double>> open_left;
+  for (double y = -0.4; y <= 0.4; y += 0.05) open_left.push_back({0.45, y});
+  for (double x = -5; x <= 0.45; x += 0.05) open_left.push_back({x, -0.4});
+  const auto left = r.openDirection(open_left, 0.3, 4.0, 0.0);
+  ASSERT_TRUE(left.has_value());
+  EXPECT_GT(*left, 0.0);
+  EXPECT_LT(*left, M_PI - 0.1);
+  // Boxed in all round: nowhere.
+  std::vector<std::pair<double, double>> box;
+  for (int i = 0; i < 360; ++i) box.push_back({0.3 * std::cos(i * kDeg), 0.3 * std::sin(i * kDeg)});
+  EXPECT_FALSE(r.openDirection(box, 0.3, 4.0, 0.0).has_value());
+
+  const hw::Pose2D from{1, 1, 0};
+  const auto ev = r.start(M_PI / 2, from, 100.0);
+  EXPECT_NEAR(ev.direction_deg, 90, 1e-9);
+  EXPECT_TRUE(r.active());
+  EXPECT_EQ(r.count(), 1);
+  // Facing away from the escape heading: turn on the spot first.
+  auto s = r.step(from, 100.1, 0.2);
+  EXPECT_DOUBLE_EQ(s.command.v, 0.0);
+  EXPECT_DOUBLE_EQ(s.command.w, 0.8);
+  EXPECT_FALSE(s.ended);
+  // Aligned: drive at the capped speed until 1 m from where it started.
+  s = r.step({1, 1.5, M_PI / 2}, 103.0, 0.2);
+  EXPECT_DOUBLE_EQ(s.command.v, 0.2);
+  EXPECT_FALSE(s.ended);
+  s = r.step({1, 2.0, M_PI / 2}, 105.0, 0.2);
+  EXPECT_TRUE(s.ended);
+  EXPECT_FALSE(r.active());
+  // Out of time, or aligned with nothing free ahead (blocked): over too.
+  r.start(0.0, from, 200.0);
+  EXPECT_TRUE(r.step(from, 208.1, 0.2).ended);
+  r.start(0.0, from, 300.0);
+  EXPECT_TRUE(r.step(from, 300.1, 0.0).ended);
+  EXPECT_EQ(r.count(), 3);
+}
+
+TEST(BehaviourParams, ValidateNamesTheSetting) {
+  auto names = [](auto p, auto&& spoil, const char* key) {
+    EXPECT_NO_THROW(p.validate());
+    spoil(p);
+    try {
+      p.validate();
+      ADD_FAILURE() << key << " accepted";
+    } catch (const std::exception& e) {
+      EXPECT_NE(std::string(e.what()).find(key), std::string::npos) << e.what();
+    }
+  };
+  names(
+      DriveParams{}, [](DriveParams& p) { p.max_w = 0; }, "nav.max_w");
+  names(
+      LookParams{}, [](LookParams& p) { p.look_bearing_deg = 95; }, "nav.look_bearing_deg");
+  names(
+      SideLookParams{}, [](SideLookParams& p) { p.side_look_min_range_m = 5; },
+      "nav.side_look_min_range_m");
+  names(
+      FinalLookParams{}, [](FinalLookParams& p) { p.final_look_s = 0; }, "nav.final_look_s");
+  names(
+      RecoverParams{}, [](RecoverParams& p) { p.recover_m = 0; }, "nav.recover_m");
+}
+
+}  // namespace
+}  // namespace sketchnav::nav
