@@ -37,6 +37,12 @@ double stampOf(const ::ros::Time& t) {
   return t.isZero() ? ::ros::Time::now().toSec() : t.toSec();
 }
 
+// [s] message stamp -> callback, for a raw or compressed camera frame alike; -1 when unknown
+// (no stamp, or stamps in simulated time, which say nothing about the transport).
+double transportDelay(const ::ros::Time& stamp) {
+  return !::ros::Time::isSimTime() && !stamp.isZero() ? (::ros::Time::now() - stamp).toSec() : -1;
+}
+
 // Why a pose from a message cannot be used, the one rule for nav_msgs/Odometry and a tf
 // odom -> base transform: a NaN or Inf in its position, its orientation quaternion or the
 // values that came with it (`extra`, e.g. the twist), or a zero quaternion (no orientation).
@@ -175,9 +181,7 @@ class RosCamera final : public hw::Camera {
     const double recv = wallNow();
     in_->wall_last = recv;
     // Stamp -> callback, when stamps are wall time (not under simulated time).
-    const double transport = !::ros::Time::isSimTime() && !m->header.stamp.isZero()
-                                 ? (::ros::Time::now() - m->header.stamp).toSec()
-                                 : -1;
+    const double transport = transportDelay(m->header.stamp);
     if (m->width == 0 || m->height == 0 || m->data.empty()) {
       bad("empty image (" + std::to_string(m->width) + "x" + std::to_string(m->height) + ", " +
           std::to_string(m->data.size()) + " bytes)");
@@ -200,9 +204,7 @@ class RosCamera final : public hw::Camera {
   void onCompressed(const sensor_msgs::CompressedImageConstPtr& m) {
     const double recv = wallNow();
     in_->wall_last = recv;
-    const double transport = !::ros::Time::isSimTime() && !m->header.stamp.isZero()
-                                 ? (::ros::Time::now() - m->header.stamp).toSec()
-                                 : -1;
+    const double transport = transportDelay(m->header.stamp);
     if (m->data.empty()) {
       bad("empty compressed image (format '" + m->format + "', 0 bytes)");
       return;
