@@ -30,6 +30,10 @@ struct FakeBaseLog {
   std::atomic<bool> moving{false};
   std::atomic<bool> stopped_from_other_thread{false};
   std::thread::id run_thread;
+  // Set by a test that compares two drawings of one frame: the runner keeps ticking but sends
+  // no new observation, so the frame on the page cannot change between the two requests.
+  std::atomic<bool> hold_observations{false};
+  std::atomic<int> ticks{0};
 };
 
 class FakeBase final : public hw::Base {
@@ -104,7 +108,7 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
       }
       hw::Frame f;
       camera->grab(f, 1.0);
-      if (i % 4 == 0) {
+      if (i % 4 == 0 && !log->hold_observations.load()) {
         nav::Observation o;
         nav::Detection d;
         d.class_name = "Oatly-Oat-Milk";
@@ -132,6 +136,7 @@ ui::Runner scriptedRunner(std::shared_ptr<FakeBaseLog> log, int max_ticks = 3000
       r.turn = servo::Turn::Straight;
       r.section = std::min(2, i / 20);
       h.on_tick(r);
+      log->ticks++;
       std::this_thread::sleep_for(std::chrono::milliseconds(10));
     }
     return {{"success", success}, {"reason", reason}};
@@ -229,6 +234,16 @@ TEST_F(UiRunHttp, StartShowsProgressAndStopStopsTheBase) {
   EXPECT_TRUE(s["health"]["base"]["ok"].get<bool>());
   EXPECT_EQ(s["base"]["last"], "command");
   EXPECT_EQ(s["perception"]["windows"], 30);
+
+  // The frame must stay the same across the two drawings compared below: hold the runner's
+  // observations and wait until it has ticked past the hold (an observation it was sending
+  // when the hold was set has then landed). A loaded machine can take longer than one
+  // observation period (40 ms) between two requests.
+  log_->hold_observations = true;
+  const int t0 = log_->ticks.load();
+  for (int i = 0; i < 500 && log_->ticks.load() < t0 + 2; ++i)
+    std::this_thread::sleep_for(std::chrono::milliseconds(5));
+  ASSERT_GE(log_->ticks.load(), t0 + 2) << "the scripted run stopped ticking";
 
   auto f = cli_->Get("/api/run/frame.jpg");
   ASSERT_EQ(f->status, 200);
