@@ -27,6 +27,8 @@ PACKAGES=(
   # the route action (generated at build time: genaction + gencpp, the .msg definitions)
   libactionlib-dev libactionlib-msgs-dev python3-genmsg python3-gencpp ros-std-msgs
   ros-actionlib-msgs
+  # the action's Python messages (genpy) and the rospy + actionlib client ros/scripts/sketchnav_route.py
+  python3-genpy python3-rospy python3-actionlib
   # /diagnostics, the annotated image, rviz markers; roslaunch / rostopic for the tests
   libdiagnostic-updater-dev libdiagnostic-msgs-dev libimage-transport-dev
   libvisualization-msgs-dev libtf2-msgs-dev python3-roslaunch python3-rostopic

@@ -1158,6 +1158,75 @@ TEST_F(RosTest, ActionGoalFeedbackResultAndCancelStopsTheRobot) {
   EXPECT_EQ(nav_->exitCode(), 0) << logs();
 }
 
+// The route action from Python (ros/scripts/sketchnav_route.py: rospy + actionlib with the
+// messages genpy generated at build time): a goal driven to success, feedback printed, the
+// result as JSON and exit 0; a second goal cancelled by the client while driving: exit 1,
+// PREEMPTED / "cancelled", and the robot stopped.
+TEST_F(RosTest, PythonActionClientDrivesAndCancelsARoute) {
+  const std::string pythonpath = SKETCHNAV_ROS_PYTHONPATH;
+  if (pythonpath.empty()) GTEST_SKIP() << "python3-genpy missing at build time: no Python messages";
+  if (std::system(SKETCHNAV_ROS_PYTHON " -c 'import rospy, actionlib' >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "python3-rospy / python3-actionlib not installed";
+  const std::string script =
+      std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/ros/scripts/sketchnav_route.py";
+  auto client = [&](std::vector<std::string> args, const std::string& name) {
+    std::vector<std::string> v = {"env", "SKETCHNAV_ROS_PYTHONPATH=" + pythonpath,
+                                  SKETCHNAV_ROS_PYTHON, script};
+    v.insert(v.end(), args.begin(), args.end());
+    return std::make_unique<Process>(v, (dir_ / (name + ".out")).string(),
+                                     (dir_ / (name + ".err")).string());
+  };
+  // Nothing to talk to: a clear message and exit 2, not a hang.
+  {
+    auto none = client(
+        {shortLabSketch(dir_), "--connect-timeout", "2", "--server", "/nobody/route"}, "none");
+    ASSERT_TRUE(none->wait(60));
+    EXPECT_EQ(none->exitCode(), 2) << none->err();
+    EXPECT_NE(none->err().find("no action server /nobody/route"), std::string::npos) << none->err();
+  }
+  startSim("1");
+  if (HasFatalFailure()) return;
+  nav_ = std::make_unique<Process>(
+      cmd({"ros", "nav", "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR, "--max-time", "60"}),
+      (dir_ / "nav.out").string(), (dir_ / "nav.err").string());
+
+  // 1. Driven to success.
+  auto ok =
+      client({shortLabSketch(dir_), "--json", "--connect-timeout", "60", "--timeout", "240"}, "ok");
+  ASSERT_TRUE(ok->wait(300)) << logs();
+  EXPECT_EQ(ok->exitCode(), 0) << ok->out() << ok->err() << logs();
+  const Json r = Json::parse(ok->out());
+  EXPECT_EQ(r["state"], "SUCCEEDED");
+  EXPECT_TRUE(r["success"].get<bool>());
+  EXPECT_EQ(r["failure"], "");
+  EXPECT_EQ(r["sections_done"], r["sections"]);
+  EXPECT_GT(r["feedback_messages"].get<int>(), 20);
+  EXPECT_TRUE(r["summary"]["success"].get<bool>());
+  EXPECT_EQ(r["summary"]["ros"]["goal_from"], "action");
+  EXPECT_NE(ok->err().find("section 1/"), std::string::npos) << ok->err();
+
+  // 2. Cancelled by the client while the robot drives the whole lab route.
+  const double sent = wallNow();
+  auto cancel = client({std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
+                        "--json", "--cancel-after", "8", "--timeout", "30"},
+                       "cancel");
+  ASSERT_TRUE(cancel->wait(120)) << logs();
+  EXPECT_EQ(cancel->exitCode(), 1) << cancel->out() << cancel->err();
+  const Json c = Json::parse(cancel->out());
+  EXPECT_EQ(c["state"], "PREEMPTED");
+  EXPECT_EQ(c["failure"], "cancelled");
+  EXPECT_TRUE(c["cancelled_by_client"].get<bool>());
+  bool moved = false;
+  for (const auto& m : commands())
+    if (m.wall > sent && std::abs(m.v) > 0.05) moved = true;
+  EXPECT_TRUE(moved) << "the robot never drove the second route" << logs();
+  std::this_thread::sleep_for(std::chrono::milliseconds(500));
+  const auto cmds = commands();
+  ASSERT_FALSE(cmds.empty());
+  EXPECT_EQ(cmds.back().v, 0.0);
+  EXPECT_EQ(cmds.back().w, 0.0);
+}
+
 // Two of the node's alternative inputs in one drive (the suite's time): odometry from tf
 // rather than nav_msgs/Odometry, and the camera as jpeg sensor_msgs/CompressedImage on
 // image_raw/compressed (the raw topic remapped away) rather than sensor_msgs/Image.
