@@ -73,6 +73,12 @@ def main():
         sys.stderr.write("sketchnav_route: %s (install python3-rospy and python3-actionlib)\n" % e)
         return 2
 
+    import rosgraph
+    # rospy.init_node waits for a master for ever; a client started by a script should not.
+    if not rosgraph.is_master_online():
+        sys.stderr.write("sketchnav_route: no ROS master at ROS_MASTER_URI=%s\n" %
+                         rosgraph.get_master_uri())
+        return 2
     rospy.init_node("sketchnav_route", anonymous=True, disable_signals=True)
     client = actionlib.SimpleActionClient(args.server, NavigateSketchAction)
     if not client.wait_for_server(rospy.Duration(args.connect_timeout)):

@@ -1184,6 +1184,18 @@ TEST_F(RosTest, PythonActionClientDrivesAndCancelsARoute) {
     EXPECT_EQ(none->exitCode(), 2) << none->err();
     EXPECT_NE(none->err().find("no action server /nobody/route"), std::string::npos) << none->err();
   }
+  // No master at all: the same, at once (rospy alone would wait for one for ever).
+  {
+    Process nomaster(
+        {"env", "ROS_MASTER_URI=http://127.0.0.1:1", "SKETCHNAV_ROS_PYTHONPATH=" + pythonpath,
+         SKETCHNAV_ROS_PYTHON, script, shortLabSketch(dir_)},
+        (dir_ / "nomaster.out").string(), (dir_ / "nomaster.err").string());
+    ASSERT_TRUE(nomaster.wait(30));
+    EXPECT_EQ(nomaster.exitCode(), 2) << nomaster.err();
+    EXPECT_NE(nomaster.err().find("no ROS master at ROS_MASTER_URI=http://127.0.0.1:1"),
+              std::string::npos)
+        << nomaster.err();
+  }
   startSim("1");
   if (HasFatalFailure()) return;
   nav_ = std::make_unique<Process>(
