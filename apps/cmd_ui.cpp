@@ -370,6 +370,14 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   };
   // The live view draws the windows perception examined: the same proposer, same settings.
   auto objectness = std::make_shared<landmarks::Objectness>(landmarks::ObjectnessParams{});
+  // A world or sketch that does not load is refused on the start request itself (400 naming
+  // the file), not reported by a run that was already answered 200.
+  ro.check_request = [](const ui::RunRequest& rq) {
+    if (!rq.hardware()) sim::loadWorldByName(rq.world);
+    const std::string sp = sketchFor(rq);
+    std::error_code ec;
+    if (!rq.sketch.empty() || (!sp.empty() && fs::exists(sp, ec))) mapsketch::loadSketch(sp);
+  };
   ro.propose_windows = [objectness](const cv::Mat& img) {
     std::vector<cv::Rect> boxes;
     for (const auto& w : objectness->propose(img, nav::PerceptionParams{}.max_windows))

@@ -321,6 +321,7 @@ void RunController::start(const RunRequest& request) {
       throw InputError("a run is already going: stop it first");
   }
   if (thread_.joinable()) thread_.join();  // the previous run has finished
+  if (opt_.check_request && !request.camera_only) opt_.check_request(request);
   // The run's folder, as `sketchnav run` writes it: <runs_dir>/<UTC time>-<world or robot>.
   std::string run_dir;
   if (!opt_.runs_dir.empty() && !request.camera_only) run_dir = newRunDir(request);

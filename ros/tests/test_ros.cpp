@@ -380,7 +380,7 @@ TEST_F(RosTest, SimAndNavThroughAMasterDriveTheShortLabRoute) {
       r["time_s"].get<double>(), r["odom_path_m"].get<double>(), s["path_length_m"].get<double>());
 }
 
-TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
+TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithin200Ms) {
   startSim("1");
   if (HasFatalFailure()) return;
   startNav(std::string(SKETCHNAV_TEST_SOURCE_DIR) + "/share/sketches/lab.sketch.json",
@@ -408,7 +408,8 @@ TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithinHalfASecond) {
   const double delay = stop_wall - killed;
   std::printf("simulator killed -> zero cmd_vel after %.3f s\n", delay);
   RecordProperty("stop_delay_ms", static_cast<int>(delay * 1000));
-  EXPECT_LT(delay, 0.5) << logs();
+  // Issue 28's bound for a killed input: the base has its stop within 200 ms.
+  EXPECT_LT(delay, 0.2) << logs();
   // No motion command after the stop, and the node ends the route as failed, saying why.
   for (const auto& c : commands())
     if (c.wall > stop_wall) EXPECT_TRUE(c.v == 0.0 && c.w == 0.0) << c.v << " " << c.w;
@@ -645,7 +646,8 @@ TEST_P(RosGarbage, StopsWithAClearLogLine) {
   std::printf("%s -> zero cmd_vel %.3f s after the %s\n", g.name, delay,
               g.stale_s > 0 ? "input went stale (last message + 0.5 s)" : "fault");
   RecordProperty("stop_delay_ms", static_cast<int>(delay * 1000));
-  EXPECT_LT(delay, 0.5) << logs();
+  // Issue 28's bound for a killed input: the base has its stop within 200 ms.
+  EXPECT_LT(delay, 0.2) << logs();
 }
 
 INSTANTIATE_TEST_SUITE_P(
@@ -758,7 +760,8 @@ TEST(RosMaster, LosingTheMasterStopsTheRoute) {
   const double ended = wallNow() - killed;
   ASSERT_GE(stopped, 0) << nav.err();
   RecordProperty("stop_delay_ms", static_cast<int>(stopped * 1000));
-  EXPECT_LT(stopped, 0.5) << nav.err();
+  // Issue 28's bound for a killed input: the stop within 200 ms.
+  EXPECT_LT(stopped, 0.2) << nav.err();
   EXPECT_EQ(nav.exitCode(), 1) << nav.err();
   const Json r = Json::parse(nav.out());
   EXPECT_FALSE(r["success"].get<bool>());

@@ -152,6 +152,12 @@ class UiRunHttp : public ::testing::Test {
     ro.runner = scriptedRunner(log_);
     ro.capture_dir = dir_ + "/landmarks";
     ro.worlds = {"corridor", "lab"};
+    // What `sketchnav ui` checks before a run starts (its world and sketch load): a stand-in
+    // that refuses one name the way a world file that does not parse is refused.
+    ro.check_request = [](const ui::RunRequest& rq) {
+      if (rq.world == "unloadable")
+        throw InputError("world 'unloadable.world.json': nested deeper than 256 levels");
+    };
     ro.propose_windows = [this](const cv::Mat& img) {
       windows_calls_++;
       return std::vector<cv::Rect>{{10, 10, 50, 50}};
@@ -348,6 +354,19 @@ TEST_F(UiRunHttp, RunnerErrorsAreShown) {
   const Json s = waitFor([](const Json& s) { return !s["active"].get<bool>(); });
   EXPECT_EQ(s["status"], "error");
   EXPECT_NE(s["reason"].get<std::string>().find("no such world"), std::string::npos);
+}
+
+// Issue 28: a world that does not load used to be answered 200 and then reported as the
+// run's error; it is refused on the start request itself, naming the file, and nothing starts.
+TEST_F(UiRunHttp, AStartWhoseWorldDoesNotLoadIsA400NamingTheFile) {
+  const auto r = post("/api/run/start", {{"world", "unloadable"}});
+  ASSERT_EQ(r->status, 400);
+  EXPECT_NE(r->body.find("unloadable.world.json"), std::string::npos) << r->body;
+  const Json s = body(cli_->Get("/api/run/state"));
+  EXPECT_EQ(s["status"], "idle");
+  EXPECT_FALSE(s["active"].get<bool>());
+  // The page is not stuck: a good request starts.
+  EXPECT_EQ(post("/api/run/start", {{"world", "corridor"}})->status, 200);
 }
 
 TEST_F(UiRunHttp, BadStartRequestsAreRefused) {

@@ -33,7 +33,10 @@ namespace sketchnav::ros {
 struct RosParams {
   double stale_timeout_s = 0.5;  // [s, wall] an input older than this stops the robot
   double wait_s = 30.0;          // [s, wall] how long opening a device waits for its first message
-  double master_check_s = 0.25;  // [s, wall] how often the master's presence is checked
+  // [s, wall] how often the master's presence is checked (one loopback or LAN XML-RPC call):
+  // a lost master stops the robot within this period plus that call, under the 200 ms a
+  // killed input may take.
+  double master_check_s = 0.1;
   std::string image_topic = "image_raw";
   std::string image_transport = "raw";  // "raw": sensor_msgs/Image on image_topic;
                                         // "compressed": sensor_msgs/CompressedImage (jpeg, png)
