@@ -52,6 +52,8 @@ void PerceptionParams::validate() const {
   require(window_max_features >= 0, "nav.perception.window_max_features", "must be >= 0");
   require(window_tilts >= 0 && window_tilts <= 4, "nav.perception.window_tilts",
           "must be in [0, 4] (tilted views per recognised window)");
+  require(tilt_confirm_frames >= 0 && tilt_confirm_frames <= 100,
+          "nav.perception.tilt_confirm_frames", "must be in [0, 100] (observe() calls)");
   require(threads >= 1 && threads <= 2, "nav.perception.threads",
           "must be 1 or 2 (the stages that run side by side)");
   track.validate();
@@ -99,6 +101,14 @@ struct LandmarkPerception::Impl {
   std::map<std::string, Track> tracks;
   int since_full = std::numeric_limits<int>::max() / 2;  // observe() calls since the full pass
   cv::Size frame_size;
+  // The last full-pass detection of each class (reported or held back) and the observe() call
+  // it came in: what confirms a tilted detection (tilt_confirm_frames).
+  struct Seen {
+    cv::Rect window;
+    long call = 0;
+  };
+  std::map<std::string, Seen> last_seen;
+  long calls = 0;  // observe() calls since construction or reset()
 };
 
 LandmarkPerception::LandmarkPerception(std::shared_ptr<const landmarks::LandmarkModel> model,
@@ -255,7 +265,10 @@ bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
                  const PerceptionParams& P, Detection& d) {
   double tilt = 1;
   for (int k = 0; k <= P.window_tilts; ++k, tilt *= std::sqrt(2.0))
-    if (examineView(model, img, crop, side, tilt, classes, K, P, d)) return true;
+    if (examineView(model, img, crop, side, tilt, classes, K, P, d)) {
+      d.tilted = k > 0;
+      return true;
+    }
   return false;
 }
 
@@ -317,7 +330,10 @@ void mergeDetection(std::vector<Detection>& found, const Detection& d, double me
   for (auto& f : found)
     if (f.class_name == d.class_name &&
         (iou(f.window, d.window) > merge_iou || std::abs(f.x_t - d.x_t) < 0.03)) {
-      if (d.inliers > f.inliers) f = d;
+      // A detection as seen outranks one found only in a tilted view of the same place: the
+      // tilted one may be held back for confirmation (tilt_confirm_frames), and it must not
+      // take an as-seen detection down with it.
+      if (f.tilted != d.tilted ? f.tilted : d.inliers > f.inliers) f = d;
       return;
     }
   found.push_back(d);
@@ -473,6 +489,29 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
   ob.timing.fovea_ms = msSince(tf);  // observeFrame() sets total_ms over all of it
 }
 
+void LandmarkPerception::confirmTilted(Observation& ob) {
+  auto& I = *impl_;
+  const auto consistent = [](const cv::Rect& a, const cv::Rect& b) {
+    const double dx = (a.x + 0.5 * a.width) - (b.x + 0.5 * b.width);
+    const double dy = (a.y + 0.5 * a.height) - (b.y + 0.5 * b.height);
+    return std::hypot(dx, dy) < std::max(a.width, b.width);
+  };
+  std::vector<Detection> kept;
+  std::map<std::string, Impl::Seen> now;
+  for (auto& d : ob.detections) {
+    bool report = true;
+    if (d.tilted) {
+      const auto it = I.last_seen.find(d.class_name);
+      report = it != I.last_seen.end() && I.calls - it->second.call <= I.p.tilt_confirm_frames &&
+               consistent(it->second.window, d.window);
+    }
+    if (!now.count(d.class_name)) now[d.class_name] = {d.window, I.calls};  // the best of each
+    if (report) kept.push_back(std::move(d));
+  }
+  for (auto& [cls, seen] : now) I.last_seen[cls] = seen;
+  ob.detections = std::move(kept);
+}
+
 Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrinsics& K,
                                         const std::vector<std::string>& classes) {
   return observeFrame(frame, K, classes, nullptr);
@@ -485,6 +524,8 @@ Observation LandmarkPerception::observe(const hw::Frame& frame, const hw::Intrin
 
 void LandmarkPerception::reset() {
   impl_->tracks.clear();
+  impl_->last_seen.clear();
+  impl_->calls = 0;
   impl_->since_full = std::numeric_limits<int>::max() / 2;
 }
 
@@ -543,10 +584,12 @@ Observation LandmarkPerception::observeFrame(const hw::Frame& frame, const hw::I
   }
   const bool full = !track || followed.empty() || ++I.since_full >= P.track.redetect_frames;
   Observation ob;
+  ++I.calls;
   if (full) {
     ob = fullPass(frame, K, classes);
     if (look_for) foveaPass(frame, K, *look_for, ob);
     I.since_full = 0;
+    if (P.tilt_confirm_frames > 0) confirmTilted(ob);
   }
   if (track) {
     // The full pass's detections restart their class's track (the detector is the authority);

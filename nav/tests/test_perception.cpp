@@ -518,6 +518,74 @@ TEST_F(RecognitionStage, TiltedViewsFindACartonTurnedAway) {
   EXPECT_EQ(wrong, 0);
 }
 
+// A detection found only in a tilted view waits for a second one of its class at a consistent
+// place within tilt_confirm_frames calls (a sibling that verifies once in a stretched view is
+// not reported); a detection as seen is never held back.
+TEST_F(RecognitionStage, TiltedDetectionsAreReportedOnlyOnceConfirmed) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  const auto look = std::vector<std::string>{kTarget, kOther};
+  PerceptionParams p;
+  p.fovea = false;
+  p.track.enabled = false;
+  p.window_tilts = 1;
+  // A scene the tilted view alone finds (as in TiltedViewsFindACartonTurnedAway).
+  hw::Frame f, moved;
+  bool have = false;
+  for (const double yaw : {-60.0, -50.0, 50.0, 60.0}) {
+    for (const double u : {200.0, 440.0}) {
+      hw::Frame c;
+      c.image =
+          sceneWithTurned(photo, yaw, 120, u, 240, 31 + static_cast<unsigned>(u + 3 * (yaw + 90)));
+      Detection d;
+      if (countClass(LandmarkPerception(model_, p).observe(c, K, look), kTarget, &d) == 0 ||
+          !d.tilted)
+        continue;
+      // The same carton 240 px away: also found tilted on its own.
+      hw::Frame m;
+      const double u2 = u < 320 ? u + 240 : u - 240;
+      m.image = sceneWithTurned(photo, yaw, 120, u2, 240,
+                                31 + static_cast<unsigned>(u2 + 3 * (yaw + 90)));
+      Detection d2;
+      if (countClass(LandmarkPerception(model_, p).observe(m, K, look), kTarget, &d2) == 0 ||
+          !d2.tilted)
+        continue;
+      f = c;
+      moved = m;
+      have = true;
+      break;
+    }
+    if (have) break;
+  }
+  ASSERT_TRUE(have) << "no scene where only the tilted view finds the carton";
+  hw::Frame blank;
+  blank.image = cv::Mat(480, 640, CV_8UC3, cv::Scalar(90, 90, 90));
+  cv::randn(blank.image, cv::Scalar(90, 90, 90), cv::Scalar(20, 20, 20));
+
+  p.tilt_confirm_frames = 2;
+  LandmarkPerception lp(model_, p);
+  Detection d;
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget), 0) << "reported unconfirmed";
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget, &d), 1) << "not reported when confirmed";
+  EXPECT_TRUE(d.tilted);
+  // Forgotten by reset().
+  lp.reset();
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget), 0);
+  // Not confirmed by a detection at another place.
+  lp.reset();
+  EXPECT_EQ(countClass(lp.observe(moved, K, look), kTarget), 0);
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget), 0);
+  // Nor by one older than tilt_confirm_frames calls.
+  lp.reset();
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget), 0);
+  lp.observe(blank, K, look);
+  lp.observe(blank, K, look);
+  EXPECT_EQ(countClass(lp.observe(f, K, look), kTarget), 0);
+  // 0: reported at once, as before.
+  p.tilt_confirm_frames = 0;
+  EXPECT_EQ(countClass(LandmarkPerception(model_, p).observe(f, K, look), kTarget), 1);
+}
+
 TEST(PerceptionParamsTest, RecognitionFieldsAreValidated) {
   PerceptionParams p;
   p.recognise_windows = p.max_windows + 1;
@@ -532,6 +600,9 @@ TEST(PerceptionParamsTest, RecognitionFieldsAreValidated) {
   p.window_tilts = -1;
   EXPECT_THROW(p.validate(), InputError);
   p.window_tilts = 5;
+  EXPECT_THROW(p.validate(), InputError);
+  p = PerceptionParams{};
+  p.tilt_confirm_frames = -1;
   EXPECT_THROW(p.validate(), InputError);
 }
 

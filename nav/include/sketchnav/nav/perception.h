@@ -43,6 +43,8 @@ struct Detection {
   // true: followed by the tracker (KltTrack) from an earlier frame's detection, not detected
   // in this frame.
   bool tracked = false;
+  // true: found in a tilted view of its window (PerceptionParams::window_tilts), not as seen.
+  bool tilted = false;
   // The verified match behind it, in frame pixels (inliers, homography, database photo): what
   // a tracker starts from and an overlay draws. Null for a Perception that does not match.
   std::shared_ptr<const landmarks::MatchResult> match;
@@ -151,10 +153,17 @@ struct PerceptionParams {
   // Tilted views of a recognised window where the view as seen finds nothing: the crop
   // stretched horizontally by sqrt(2)^k, k = 1..window_tilts (a landmark turned ~45 and ~60
   // degrees away, foreshortened by cos(yaw), seen at its face's proportions). Each view costs
-  // one more recognition of the window. 0 = the window as seen only. Off by default: on the
-  // bench's sequences it finds more but also reports a sibling class more often
-  // (doc/perception-benchmark.md, 'Tilted views').
-  int window_tilts = 0;
+  // one more recognition of the window. 0 = the window as seen only. Alone it also lets a
+  // look-alike sibling through now and then; with tilt_confirm_frames (below) it does not.
+  // Evidence for the default: doc/perception-benchmark.md, 'Tilted views with confirmation'.
+  int window_tilts = 1;
+  // A detection found only in a tilted view is reported when the same class was also detected
+  // (as seen or tilted) in one of the previous tilt_confirm_frames observe() calls at a
+  // consistent place (the two windows' centres less than the wider window's width apart);
+  // else it is held back and only remembered. A stretched view lets a look-alike sibling
+  // verify now and then; a landmark turned away verifies again frame after frame. 0 = a
+  // tilted detection is reported at once.
+  int tilt_confirm_frames = 2;
   // Threads a full pass uses for its independent stages: the objectness windows beside the
   // frame's features, and the ranked windows' recognition split between them. 1 = everything on
   // the calling thread. The detections are the same for any count (only the wall time
@@ -193,6 +202,7 @@ struct PerceptionParams {
     b("window_margin", window_margin);
     b("window_max_features", window_max_features);
     b("window_tilts", window_tilts);
+    b("tilt_confirm_frames", tilt_confirm_frames);
     b("threads", threads);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
@@ -230,6 +240,9 @@ class LandmarkPerception final : public Perception {
                        const std::vector<std::string>& classes);
   void foveaPass(const hw::Frame& frame, const hw::Intrinsics& k,
                  const std::vector<LookFor>& look_for, Observation& ob);
+  // Holds back the tilted detections of a full pass that no recent detection confirms
+  // (PerceptionParams::tilt_confirm_frames) and remembers this pass's detections.
+  void confirmTilted(Observation& ob);
   struct Impl;
   std::unique_ptr<Impl> impl_;
 };
