@@ -3,9 +3,9 @@
 #include <iostream>
 
 #include "cli.h"
-#include "run_harness.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/run/run.h"
 
 namespace sketchnav::app {
 namespace {
@@ -37,7 +37,7 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
               "run simulator-free on a recorded rawlog or ROS bag (from --record, or a bag of ros "
               "sim's topics)");
   if (!args.parse(argv)) return 0;
-  RunOptions o;
+  run::RunOptions o;
   o.world = args.get("world");
   o.sketch = args.get("sketch");
   o.model = args.get("model");
@@ -68,7 +68,7 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   o.config = g.config;
   o.out_dir = makeOutputDir(args.get("out"));
   o.progress = true;
-  const Json summary = runNavigation(o);
+  const Json summary = run::runNavigation(o);
   if (g.json) {
     printJson(summary);
   } else {

@@ -2,7 +2,7 @@
 // unless told otherwise; see doc/ui.md.
 // Eigen-using headers first: a macro pulled in by httplib.h (server.h) breaks Eigen's headers.
 // clang-format off
-#include "run_harness.h"
+#include "sketchnav/run/run.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
@@ -247,7 +247,7 @@ Json cameraOnly(const ui::RunRequest& rq, const ui::RunHooks& h) {
 // The run page's runner: `sketchnav run` (runNavigation) in real time, reporting to the page.
 Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::string& landmarks,
                  const std::string& model_cache) {
-  RunOptions o;
+  run::RunOptions o;
   o.world = rq.world;
   o.sketch = rq.sketch;
   o.robot = rq.robot;
@@ -297,7 +297,7 @@ Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::str
     log::warn("ui", "no map for the run page", {{"error", e.what()}});
     h.on_map(Json::object());
   }
-  return runNavigation(o);
+  return run::runNavigation(o);
 }
 
 std::vector<std::string> filesEndingIn(const std::string& dir, const std::string& suffix) {

@@ -1,4 +1,4 @@
-#include "scenario.h"
+#include "sketchnav/run/scenario.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -16,12 +16,12 @@
 #include <sstream>
 #include <thread>
 
-#include "run_harness.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/landmarks/model.h"
+#include "sketchnav/run/run.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 namespace fs = std::filesystem;
 
 std::string selfExecutable() {
@@ -219,4 +219,4 @@ std::vector<ScenarioResult> runScenarios(const std::vector<ScenarioSpec>& specs,
   return results;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

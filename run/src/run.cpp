@@ -1,4 +1,4 @@
-#include "run_harness.h"
+#include "sketchnav/run/run.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -35,12 +35,15 @@
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/sections.h"
+#include "sketchnav/run/judge.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world_check.h"
 
-namespace sketchnav::app {
+#include "frames.h"
+
+namespace sketchnav::run {
 namespace fs = std::filesystem;
 
 std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir) {
@@ -116,18 +119,6 @@ void checkWorldForRun(const sim::World& w, const landmarks::LandmarkModel& model
 
 bool looksLikePath(const std::string& s) {
   return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
-}
-
-// Odometry frame <-> world frame in simulation: the odometry frame starts at the world's start
-// pose (origin there, +x along its heading).
-Eigen::Vector2d odomToWorld(const hw::Pose2D& start, const Eigen::Vector2d& o) {
-  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
-  return {start.x + cs * o.x() - ss * o.y(), start.y + ss * o.x() + cs * o.y()};
-}
-Eigen::Vector2d worldToOdom(const hw::Pose2D& start, const Eigen::Vector2d& p) {
-  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
-  const Eigen::Vector2d d(p.x() - start.x, p.y() - start.y);
-  return {cs * d.x() + ss * d.y(), -ss * d.x() + cs * d.y()};
 }
 
 // Route frame -> world frame for drawing: the route's start at the world start pose, facing
@@ -310,21 +301,6 @@ void drawTrajectory(const std::string& path, const sim::World& world,
 
 }  // namespace
 
-std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Route& route,
-                                       double fit_outlier_m) {
-  // The landmarks' true places in the odometry frame (the robot starts at its origin, facing
-  // +x), the refit of nav::goalFromExactFixes, and its goal back in the world. The scale bound
-  // is loose: fit after fit, the navigation's scale may move that far too.
-  std::map<std::string, Eigen::Vector2d> truth;
-  for (const auto& l : w.landmarks) truth[l.id] = worldToOdom(w.start, l.position);
-  nav::WeightedFitParams wp;
-  wp.outlier_m = fit_outlier_m;
-  wp.max_scale_change = 0.5;
-  const auto g = nav::goalFromExactFixes(route, truth, wp);
-  if (!g) return std::nullopt;
-  return (odomToWorld(w.start, *g) - w.goal.centre).norm();
-}
-
 RunSettings runSettingsFrom(const Config& c) {
   RunSettings r;
   applyConfig(r.route, c, "route");
@@ -362,39 +338,9 @@ Json runSettingsJson(const RunSettings& r, bool with_sim) {
   return j;
 }
 
-std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary& es) {
-  if (success) return "";
-  if (collided) return "collision";
-  if (es.status == nav::RunStatus::Succeeded) return "short_of_goal";
-  const std::string code = nav::toString(es.failure);
-  return code.empty() ? "unknown" : code;
-}
-
 const std::vector<std::string>& driverSettingPrefixes() {
   static const std::vector<std::string> p = {"base.", "camera.", "laser.", "sonar."};
   return p;
-}
-
-RunVerdict judgeSimulatedRun(bool executive_ok, const std::string& executive_reason, bool at_goal,
-                             bool collided, const std::string& collided_with, double to_goal_m) {
-  RunVerdict v;
-  v.success = at_goal && !collided;
-  if (collided) {
-    v.reason = "collision with " + collided_with +
-               (executive_reason.empty() ? "" : "; " + executive_reason);
-  } else if (!at_goal && executive_ok) {
-    char b[160];
-    std::snprintf(b, sizeof b, "route completed but the robot stopped %.2f m from the goal",
-                  to_goal_m);
-    v.reason = b;
-  } else if (at_goal) {
-    v.reason = executive_ok
-                   ? "reached the goal"
-                   : "reached the goal region, but the executive failed: " + executive_reason;
-  } else {
-    v.reason = executive_reason;
-  }
-  return v;
 }
 
 Json runNavigation(const RunOptions& o) {
@@ -773,4 +719,4 @@ Json runNavigation(const RunOptions& o) {
   return s;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run
