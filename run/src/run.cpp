@@ -36,6 +36,7 @@
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/sections.h"
 #include "sketchnav/run/judge.h"
+#include "sketchnav/run/run_folder.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
@@ -140,13 +141,9 @@ class RunObserver final : public nav::ExecutiveObserver {
       : progress_(progress), sim_(sim), sections_(sections) {
     if (!out.empty()) {
       events_.open(out + "/events.jsonl");
-      tele_.open(out + "/telemetry.csv");
-      if (!events_ || !tele_) throw RuntimeError("cannot write run files in " + out);
-      // Header flushed at open and every row written whole and flushed (one write()): a run
-      // killed at any moment leaves telemetry.csv readable to its last whole row.
-      tele_ << "t,odom_x,odom_y,odom_theta,true_x,true_y,true_theta,v_cmd,w_cmd,servo_error,"
-               "mode,turn,section,landmark,front_free_m\n"
-            << std::flush;
+      // (The telemetry writer flushes its header at open and writes every row whole.)
+      const bool tele_ok = tele_.open(out + "/telemetry.csv");
+      if (!events_ || !tele_ok) throw RuntimeError("cannot write run files in " + out);
     }
   }
   std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
@@ -210,19 +207,7 @@ class RunObserver final : public nav::ExecutiveObserver {
     if (sim_) truth = sim_->truePose();
     last_truth = truth;
     odom.push_back(r.odom);
-    if (tele_.is_open()) {
-      std::ostringstream row;
-      row << r.t << ',' << r.odom.x << ',' << r.odom.y << ',' << r.odom.theta << ',';
-      if (sim_)
-        row << truth.x << ',' << truth.y << ',' << truth.theta << ',';
-      else
-        row << ",,,";
-      row << r.v_cmd << ',' << r.w_cmd << ',';
-      if (std::isfinite(r.servo_error)) row << r.servo_error;
-      row << ',' << nav::toString(r.mode) << ',' << servo::toString(r.turn) << ',' << r.section
-          << ',' << r.landmark << ',' << r.front_free_m << '\n';
-      tele_ << row.str() << std::flush;
-    }
+    tele_.write(r, sim_ ? &truth : nullptr);
     if (progress_ && r.t >= next_progress_) {
       next_progress_ = r.t + 5.0;
       char buf[200];
@@ -243,7 +228,8 @@ class RunObserver final : public nav::ExecutiveObserver {
   bool progress_;
   sim::Simulator* sim_;
   int sections_;
-  std::ofstream events_, tele_;
+  std::ofstream events_;
+  TelemetryWriter tele_;
   double next_progress_ = 0;
 };
 

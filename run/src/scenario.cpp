@@ -20,6 +20,7 @@
 #include "sketchnav/core/paths.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/run/run.h"
+#include "sketchnav/run/run_folder.h"
 
 namespace sketchnav::run {
 namespace fs = std::filesystem;
@@ -48,24 +49,6 @@ std::string ensureModel(const std::string& model, bool progress) {
 }
 
 namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
-}
-
-double num(const std::vector<std::string>& row, int i) {
-  if (i < 0 || i >= static_cast<int>(row.size()) || row[i].empty()) return NAN;
-  try {
-    return std::stod(row[i]);
-  } catch (...) {
-    return NAN;
-  }
-}
 
 double jnum(const Json& j, const char* key, double def = 0) {
   return j.contains(key) && j[key].is_number() ? j[key].get<double>() : def;
@@ -149,32 +132,19 @@ ScenarioResult readRunFolder(const std::string& dir) {
     r.deviation_max_m = jnum(s["deviation_m"], "max", NAN);
   }
   // Telemetry: the true poses and the commanded yaw rate.
-  std::ifstream tc(dir + "/telemetry.csv");
-  std::string line;
-  if (tc && std::getline(tc, line)) {
-    const auto head = splitCsv(line);
-    auto col = [&](const std::string& n) {
-      for (size_t i = 0; i < head.size(); ++i)
-        if (head[i] == n) return static_cast<int>(i);
-      return -1;
-    };
-    const int cx = col("true_x"), cy = col("true_y"), ct = col("true_theta"), cw = col("w_cmd");
-    int last_sign = 0, changes = 0;
-    while (std::getline(tc, line)) {
-      const auto row = splitCsv(line);
-      const double x = num(row, cx), y = num(row, cy), th = num(row, ct), w = num(row, cw);
-      if (std::isfinite(x) && std::isfinite(y))
-        r.trajectory.push_back({x, y, std::isfinite(th) ? th : 0.0});
-      // A sign change counts when |w| is clearly non-zero on both sides (1e-3 rad/s), so
-      // going straight between two turns the same way is not an oscillation.
-      if (std::isfinite(w) && std::abs(w) > 1e-3) {
-        const int sg = w > 0 ? 1 : -1;
-        if (last_sign != 0 && sg != last_sign) ++changes;
-        last_sign = sg;
-      }
+  int last_sign = 0, changes = 0;
+  for (const TelemetryRecord& t : readTelemetryCsv(dir + "/telemetry.csv")) {
+    if (t.truth) r.trajectory.push_back(*t.truth);
+    // A sign change counts when |w| is clearly non-zero on both sides (1e-3 rad/s), so
+    // going straight between two turns the same way is not an oscillation.
+    const double w = t.w_cmd;
+    if (std::isfinite(w) && std::abs(w) > 1e-3) {
+      const int sg = w > 0 ? 1 : -1;
+      if (last_sign != 0 && sg != last_sign) ++changes;
+      last_sign = sg;
     }
-    r.oscillation_per_m = r.path_m > 0.1 ? changes / r.path_m : 0.0;
   }
+  r.oscillation_per_m = r.path_m > 0.1 ? changes / r.path_m : 0.0;
   return r;
 }
 
