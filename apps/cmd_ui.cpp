@@ -51,26 +51,10 @@ bool endsWith(const std::string& s, const std::string& suffix) {
 // The sketch a run uses when the page names none (as runNavigation picks it).
 std::string sketchFor(const ui::RunRequest& rq) {
   if (!rq.sketch.empty()) return rq.sketch;
-  const std::string w = rq.hardware() ? "lab" : rq.world;
-  if (w.find('/') != std::string::npos || endsWith(w, ".json")) {
-    if (endsWith(w, ".world.json")) return w.substr(0, w.size() - 11) + ".sketch.json";
-    return "";
-  }
-  return resourcePath("sketches/" + w + ".sketch.json");
+  return run::defaultSketchPath(rq.hardware() ? "lab" : rq.world);
 }
 
 Json worldGeometry(const std::string& world);
-
-// The drawn path in the route frame (metres; the frame of Route::guide_points_m).
-std::vector<Eigen::Vector2d> sketchPathInRoute(const mapsketch::Sketch& sk,
-                                               const mapsketch::Route& route) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(sk.path.size());
-  for (const auto& p : sk.path)
-    out.push_back(route.start_m + Eigen::Vector2d((p.x() - sk.start.x()) * route.scale_m_per_px,
-                                                  -(p.y() - sk.start.y()) * route.scale_m_per_px));
-  return out;
-}
 
 // The route as the executive places it now (its SectionTracker's route -> odometry
 // alignment, refitted at landmark fixes), for the run page's map. Called after every step;
@@ -148,7 +132,7 @@ Json mapGeometry(const ui::RunRequest& rq) {
       return V(c * d.x() - s * d.y(), s * d.x() + c * d.y());
     };
     Json path = Json::array();
-    for (const auto& p : sketchPathInRoute(sk, route)) path.push_back(pt(toOdom(p)));
+    for (const auto& p : run::drawnPathInRoute(sk, route)) path.push_back(pt(toOdom(p)));
     Json guides = Json::array(), lms = Json::array();
     for (const auto& p : route.guide_points_m) guides.push_back(pt(toOdom(p)));
     for (const auto& sec : route.sections)

@@ -118,10 +118,6 @@ void checkWorldForRun(const sim::World& w, const landmarks::LandmarkModel& model
   for (const auto& i : issues) log::warn("run", i.text(origin));
 }
 
-bool looksLikePath(const std::string& s) {
-  return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
-}
-
 // Route frame -> world frame for drawing: the route's start at the world start pose, facing
 // along the first section (the executive's initial alignment).
 struct RouteToWorld {
@@ -263,11 +259,7 @@ void drawTrajectory(const std::string& path, const sim::World& world,
   sim::MapCanvas canvas(world, 40.0, 0.5, true);
   // The hand-drawn path as drawn (canvas px -> route frame -> world), solid.
   std::vector<Eigen::Vector2d> drawn;
-  for (const auto& p : sketch.path) {
-    const Eigen::Vector2d rp((p.x() - sketch.start.x()) * route.scale_m_per_px,
-                             -(p.y() - sketch.start.y()) * route.scale_m_per_px);
-    drawn.push_back(r2w(rp + route.start_m));
-  }
+  for (const auto& p : drawnPathInRoute(sketch, route)) drawn.push_back(r2w(p));
   canvas.drawPolyline(drawn, {0, 0, 0}, false, 2);
   // Where the sketch put the landmarks (hollow grey), next to the real ones the map shows.
   for (const auto& sec : route.sections)
@@ -286,6 +278,29 @@ void drawTrajectory(const std::string& path, const sim::World& world,
 }
 
 }  // namespace
+
+bool isWorldFile(const std::string& s) {
+  return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
+}
+
+std::string defaultSketchPath(const std::string& world) {
+  if (!isWorldFile(world)) return resourcePath("sketches/" + world + ".sketch.json");
+  const std::string suffix = ".world.json";
+  if (world.size() > suffix.size() && world.substr(world.size() - suffix.size()) == suffix)
+    return world.substr(0, world.size() - suffix.size()) + ".sketch.json";
+  return "";
+}
+
+std::vector<Eigen::Vector2d> drawnPathInRoute(const mapsketch::Sketch& sketch,
+                                              const mapsketch::Route& route) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(sketch.path.size());
+  for (const auto& p : sketch.path)
+    out.push_back(route.start_m +
+                  Eigen::Vector2d((p.x() - sketch.start.x()) * route.scale_m_per_px,
+                                  -(p.y() - sketch.start.y()) * route.scale_m_per_px));
+  return out;
+}
 
 RunSettings runSettingsFrom(const Config& c) {
   RunSettings r;
@@ -358,7 +373,7 @@ Json runNavigation(const RunOptions& o) {
   std::string world_name = o.world;
   if (!hardware) {
     std::string world_uri;
-    if (looksLikePath(o.world)) {
+    if (isWorldFile(o.world)) {
       if (!fs::exists(o.world)) throw InputError("--world " + o.world + ": no such file");
       world_uri = "sim://" + fs::absolute(o.world).string();
     } else {
@@ -422,15 +437,13 @@ Json runNavigation(const RunOptions& o) {
   // --- sketch -> route ----------------------------------------------------------------------
   std::string sketch_path = o.sketch;
   if (sketch_path.empty()) {
-    if (looksLikePath(o.world)) {
-      std::string p = o.world;
-      const std::string suffix = ".world.json";
-      if (p.size() > suffix.size() && p.substr(p.size() - suffix.size()) == suffix)
-        p = p.substr(0, p.size() - suffix.size()) + ".sketch.json";
-      if (!fs::exists(p)) throw InputError("--sketch is required (no " + p + ")");
-      sketch_path = p;
-    } else {
-      sketch_path = resourcePath("sketches/" + o.world + ".sketch.json");
+    sketch_path = defaultSketchPath(o.world);
+    if (isWorldFile(o.world)) {
+      // A world file not named *.world.json has no sketch beside it by convention: the file
+      // itself is tried, and loadSketch says why it is not a sketch.
+      if (sketch_path.empty()) sketch_path = o.world;
+      if (!fs::exists(sketch_path))
+        throw InputError("--sketch is required (no " + sketch_path + ")");
     }
   }
   const mapsketch::Sketch sketch = mapsketch::loadSketch(sketch_path);

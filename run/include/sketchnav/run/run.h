@@ -14,6 +14,7 @@
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/mapsketch/route.h"
+#include "sketchnav/mapsketch/sketch.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/perception.h"
 #include "sketchnav/sim/simulator.h"
@@ -75,6 +76,21 @@ const std::vector<std::string>& driverSettingPrefixes();
 /// Runs one navigation. Returns the summary object (what summary.json holds). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.
 Json runNavigation(const RunOptions& options);
+
+/// Whether RunOptions::world names a world file (a path, or a name ending in ".json") rather
+/// than a world in share/worlds.
+bool isWorldFile(const std::string& world);
+
+/// The sketch a run over `world` (RunOptions::world) uses when it is given none: for a world
+/// file "x.world.json", "x.sketch.json" beside it (not checked to exist); for a world name, the
+/// shipped share/sketches/<name>.sketch.json (RuntimeError naming it when there is none); ""
+/// for a world file of another name.
+std::string defaultSketchPath(const std::string& world);
+
+/// The path drawn on `sketch` (canvas pixels) in the frame of `route` = toRoute(sketch) [m]
+/// (Route::guide_points_m's frame: the sketch's start at route.start_m, y up).
+std::vector<Eigen::Vector2d> drawnPathInRoute(const mapsketch::Sketch& sketch,
+                                              const mapsketch::Route& route);
 
 /// The landmark model cache file for a landmark set folder (keyed by its content hash).
 std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir);
