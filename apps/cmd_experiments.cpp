@@ -1,5 +1,5 @@
 // sketchnav experiments: the paper's experiments 2-4 in simulation, N trials each; report.
-// Variants are generated from the lab world (exp_variants.h); every trial draws its own
+// Variants are generated from the lab world (run/experiments.h); every trial draws its own
 // sketch (sketch noise) and runs with its own simulator seed (odometry / sensor noise).
 #include <cmath>
 #include <cstdio>
