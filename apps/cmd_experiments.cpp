@@ -23,6 +23,7 @@
 #include "sketchnav/run/judge.h"
 #include "sketchnav/run/run.h"
 #include "sketchnav/run/scenario.h"
+#include "sketchnav/run/summary.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/world.h"
 
@@ -225,10 +226,11 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       const auto& r = results[i];
       rs.push_back(&r);
       ++st.trials;
-      const Json* diag = r.summary.contains("diagnostics") ? &r.summary["diagnostics"] : nullptr;
-      if (diag && diag->contains("sketch_goal_error_m")) {
+      // (A trial without a summary has none.)
+      const auto diag = r.ran ? run::RunSummary::fromJson(r.summary).diagnostics : std::nullopt;
+      if (diag && diag->sketch_goal_error_m) {
         ++st.sketch_known;
-        st.sketch_limited += (*diag)["sketch_goal_error_m"].get<double>() > goal_radius;
+        st.sketch_limited += *diag->sketch_goal_error_m > goal_radius;
       }
       if (r.success) {
         ++st.successes;

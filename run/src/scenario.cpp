@@ -21,6 +21,7 @@
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/run/run.h"
 #include "sketchnav/run/run_folder.h"
+#include "sketchnav/run/summary.h"
 
 namespace sketchnav::run {
 namespace fs = std::filesystem;
@@ -49,10 +50,6 @@ std::string ensureModel(const std::string& model, bool progress) {
 }
 
 namespace {
-
-double jnum(const Json& j, const char* key, double def = 0) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : def;
-}
 
 // Runs one child; returns its exit status (-1 when it could not start).
 int spawnRun(const ScenarioSpec& s, const std::string& exe) {
@@ -118,19 +115,17 @@ ScenarioResult readRunFolder(const std::string& dir) {
     r.failure = "no_summary";
     return r;
   }
-  const Json& s = r.summary;
+  const RunSummary s = RunSummary::fromJson(r.summary);
   r.ran = true;
-  r.success = s.value("success", false);
-  r.reason = s.value("reason", "");
-  r.failure = s.value("failure", "");
-  r.time_s = jnum(s, "time_s");
-  r.path_m = jnum(s, "path_length_m");
-  r.min_clearance_m = jnum(s, "min_clearance_m", NAN);
-  r.wall_s = jnum(s, "wall_time_s");
-  if (s.contains("deviation_m") && s["deviation_m"].is_object()) {
-    r.deviation_mean_m = jnum(s["deviation_m"], "mean", NAN);
-    r.deviation_max_m = jnum(s["deviation_m"], "max", NAN);
-  }
+  r.success = s.success;
+  r.reason = s.reason;
+  r.failure = s.failure;
+  r.time_s = s.time_s;
+  r.path_m = s.path_length_m;
+  r.min_clearance_m = s.min_clearance_m;
+  r.wall_s = s.wall_time_s;
+  r.deviation_mean_m = s.deviation_mean_m;
+  r.deviation_max_m = s.deviation_max_m;
   // Telemetry: the true poses and the commanded yaw rate.
   int last_sign = 0, changes = 0;
   for (const TelemetryRecord& t : readTelemetryCsv(dir + "/telemetry.csv")) {

@@ -73,7 +73,8 @@ Json runSettingsJson(const RunSettings& settings, bool with_sim = true);
 /// The prefixes of device drivers' settings, applied only when a device is opened.
 const std::vector<std::string>& driverSettingPrefixes();
 
-/// Runs one navigation. Returns the summary object (what summary.json holds). Throws
+/// Runs one navigation. Returns the summary object (what summary.json holds; summary.h reads
+/// its figures typed: RunSummary::fromJson). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.
 Json runNavigation(const RunOptions& options);
 
