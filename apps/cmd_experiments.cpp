@@ -1,5 +1,5 @@
 // sketchnav experiments: the paper's experiments 2-4 in simulation, N trials each; report.
-// Variants are generated from the lab world (exp_variants.h); every trial draws its own
+// Variants are generated from the lab world (run/experiments.h); every trial draws its own
 // sketch (sketch noise) and runs with its own simulator seed (odometry / sensor noise).
 #include <cmath>
 #include <cstdio>
@@ -13,15 +13,17 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli.h"
-#include "exp_variants.h"
-#include "run_harness.h"
-#include "scenario.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
+#include "sketchnav/run/experiments.h"
+#include "sketchnav/run/judge.h"
+#include "sketchnav/run/run.h"
+#include "sketchnav/run/scenario.h"
+#include "sketchnav/run/summary.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/world.h"
 
@@ -35,7 +37,7 @@ struct VariantStats {
   // every landmark fixed exactly (summary diagnostics.sketch_goal_error_m) misses it.
   int sketch_limited = 0, sketch_known = 0;
   double time_sum = 0;
-  std::vector<TrialFailure> failures;  // of the failed trials
+  std::vector<run::TrialFailure> failures;  // of the failed trials
 };
 
 // The share of `n` seeded sketches of `v` (seeds seed0, seed0 + 1, ...: the trials' sketches
@@ -43,7 +45,7 @@ struct VariantStats {
 // lands inside the goal region: the success rate a robot with perfect perception and odometry
 // reaches with the navigation's refit. Measured on many sketches, not only the trials', so a
 // variant's aim can be judged against what its drawing errors allow.
-double sketchCeiling(const Variant& v, const SketchNoise& noise, int seed0, int n,
+double sketchCeiling(const run::Variant& v, const run::SketchNoise& noise, int seed0, int n,
                      const Config& config) {
   const sim::World world = sim::worldFromJson(v.world, v.name, resourceDir());
   mapsketch::RouteParams rp;
@@ -52,9 +54,9 @@ double sketchCeiling(const Variant& v, const SketchNoise& noise, int seed0, int 
   int inside = 0;
   for (int k = 0; k < n; ++k) {
     try {
-      const auto route =
-          mapsketch::toRoute(mapsketch::sketchFromJson(variantSketch(v, noise, seed0 + k)), rp);
-      const auto e = sketchGoalErrorM(world, route, outlier_m);
+      const auto route = mapsketch::toRoute(
+          mapsketch::sketchFromJson(run::variantSketch(v, noise, seed0 + k)), rp);
+      const auto e = run::sketchGoalErrorM(world, route, outlier_m);
       inside += e && *e <= world.goal.radius;
     } catch (const InputError&) {
       // A sketch that gives no route cannot be followed: it counts as outside.
@@ -63,8 +65,8 @@ double sketchCeiling(const Variant& v, const SketchNoise& noise, int seed0, int 
   return n > 0 ? static_cast<double>(inside) / n : NAN;
 }
 
-void drawVariantFigure(const std::string& path, const Variant& v,
-                       const std::vector<const ScenarioResult*>& trials) {
+void drawVariantFigure(const std::string& path, const run::Variant& v,
+                       const std::vector<const run::ScenarioResult*>& trials) {
   const sim::World world = sim::worldFromJson(v.world, v.name, resourceDir());
   sim::MapCanvas canvas(world, 40.0, 0.5, true);
   canvas.drawPolyline(v.drawn_path, {0, 0, 0}, false, 2);
@@ -120,8 +122,8 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
       .flag("list", "print the variant names and descriptions and exit");
   if (!args.parse(argv)) return 0;
   if (args.flagSet("list")) {
-    for (const auto& n : variantNames())
-      std::cout << n << "\t" << makeVariant(n).description << "\n";
+    for (const auto& n : run::variantNames())
+      std::cout << n << "\t" << run::makeVariant(n).description << "\n";
     return 0;
   }
   const int trials = args.getInt("trials");
@@ -138,32 +140,32 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (!(max_time > 0)) throw InputError("--max-time must be positive");
   }
   std::vector<std::string> names =
-      args.get("variants").empty() ? variantNames() : args.getList("variants");
-  std::vector<Variant> variants;
-  for (const auto& n : names) variants.push_back(makeVariant(n));  // InputError on unknown
-  const SketchNoise noise = sketchNoiseFrom(g.config);
+      args.get("variants").empty() ? run::variantNames() : args.getList("variants");
+  std::vector<run::Variant> variants;
+  for (const auto& n : names) variants.push_back(run::makeVariant(n));  // InputError on unknown
+  const run::SketchNoise noise = run::sketchNoiseFrom(g.config);
   // The trials' settings (every run setting; the trials apply them again): a typo fails here.
-  runSettingsFrom(g.config);
-  g.config.requireAllUsedExcept(driverSettingPrefixes());
+  run::runSettingsFrom(g.config);
+  g.config.requireAllUsedExcept(run::driverSettingPrefixes());
 
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model = ensureModel(args.get("model"), true);
-  const std::string config_file = writeBatchConfig(g.config, out);
+  const std::string model = run::ensureModel(args.get("model"), true);
+  const std::string config_file = run::writeBatchConfig(g.config, out);
 
-  std::vector<ScenarioSpec> specs;
+  std::vector<run::ScenarioSpec> specs;
   for (size_t vi = 0; vi < variants.size(); ++vi) {
-    const Variant& v = variants[vi];
+    const run::Variant& v = variants[vi];
     const std::string vdir = out + "/" + v.name;
-    const std::string wf = writeVariantWorld(v, vdir);
+    const std::string wf = run::writeVariantWorld(v, vdir);
     for (int k = 0; k < trials; ++k) {
-      ScenarioSpec s;
+      run::ScenarioSpec s;
       s.seed = seed0 + k;
       s.label = v.name + " #" + std::to_string(k + 1);
       s.world_file = wf;
       s.out_dir = vdir + "/trial-" + std::to_string(k + 1);
       fs::create_directories(s.out_dir);
       s.sketch_file = s.out_dir + "/sketch.json";
-      writeVariantSketch(v, noise, s.seed, s.sketch_file);
+      run::writeVariantSketch(v, noise, s.seed, s.sketch_file);
       s.model = model;
       s.config_file = config_file;
       s.max_time_s = max_time;
@@ -178,7 +180,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
     for (size_t vi = 0; vi < variants.size(); ++vi)
       ceiling[vi] = sketchCeiling(variants[vi], noise, seed0, ceiling_n, g.config);
   }
-  const auto results = runScenarios(specs, jobs, true);
+  const auto results = run::runScenarios(specs, jobs, true);
 
   // --- aggregate, figures, report ---------------------------------------------------------
   Json jv = Json::object();
@@ -214,26 +216,27 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
   table << "variant                   trials  success  rate    mean time [s]  sketch-limited  "
            "ceiling\n";
   for (size_t vi = 0; vi < variants.size(); ++vi) {
-    const Variant& v = variants[vi];
+    const run::Variant& v = variants[vi];
     VariantStats st;
     const double goal_radius =
         v.world.contains("goal") ? v.world["goal"].value("radius", 0.5) : 0.5;
-    std::vector<const ScenarioResult*> rs;
+    std::vector<const run::ScenarioResult*> rs;
     for (size_t i = 0; i < specs.size(); ++i) {
       if (specs[i].label.rfind(v.name + " #", 0) != 0) continue;
       const auto& r = results[i];
       rs.push_back(&r);
       ++st.trials;
-      const Json* diag = r.summary.contains("diagnostics") ? &r.summary["diagnostics"] : nullptr;
-      if (diag && diag->contains("sketch_goal_error_m")) {
+      // (A trial without a summary has none.)
+      const auto diag = r.ran ? run::RunSummary::fromJson(r.summary).diagnostics : std::nullopt;
+      if (diag && diag->sketch_goal_error_m) {
         ++st.sketch_known;
-        st.sketch_limited += (*diag)["sketch_goal_error_m"].get<double>() > goal_radius;
+        st.sketch_limited += *diag->sketch_goal_error_m > goal_radius;
       }
       if (r.success) {
         ++st.successes;
         st.time_sum += r.time_s;
       } else {
-        st.failures.push_back(trialFailure(r.failure, r.reason, r.summary));
+        st.failures.push_back(run::trialFailure(r.failure, r.reason, r.summary));
       }
     }
     const double rate = st.trials ? static_cast<double>(st.successes) / st.trials : 0.0;
@@ -258,7 +261,7 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
                       ? (std::to_string(static_cast<int>(std::lround(mean_t)))).c_str()
                       : "-",
                   limited.c_str(), ceil_s);
-    md << buf << summariseFailures(st.failures) << " |\n";
+    md << buf << run::summariseFailures(st.failures) << " |\n";
     std::snprintf(buf, sizeof buf, "%-25s %6d  %7d  %5.0f %%  %-13s  %-14s  %s\n", v.name.c_str(),
                   st.trials, st.successes, 100 * rate,
                   std::isfinite(mean_t) ? std::to_string(mean_t).substr(0, 6).c_str() : "-",

@@ -21,7 +21,6 @@
 
 #include "cli.h"
 #include "perception_bench.h"
-#include "scenario.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
 #include "sketchnav/core/paths.h"
@@ -30,6 +29,7 @@
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/landmarks/recognition.h"
 #include "sketchnav/nav/perception.h"
+#include "sketchnav/run/scenario.h"
 #include "sketchnav/servo/turn_law.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
@@ -324,7 +324,7 @@ int runEval(const Args& args, GlobalOptions& g) {
     seqs.push_back(bench::readSequenceJson((d / "sequence.json").string()));
   }
   auto model = std::make_shared<landmarks::LandmarkModel>(
-      landmarks::LandmarkModel::load(ensureModel(args.get("model"), true)));
+      landmarks::LandmarkModel::load(run::ensureModel(args.get("model"), true)));
   const auto& cls = model->classes();
   for (size_t s = 0; s < seqs.size(); ++s)
     if (std::find(cls.begin(), cls.end(), seqs[s].target) == cls.end())
@@ -509,7 +509,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   }
 
   auto model = std::make_shared<landmarks::LandmarkModel>(
-      landmarks::LandmarkModel::load(ensureModel(args.get("model"), true)));
+      landmarks::LandmarkModel::load(run::ensureModel(args.get("model"), true)));
   const auto& cls = model->classes();
   if (std::find(cls.begin(), cls.end(), target) == cls.end()) {
     std::string known;

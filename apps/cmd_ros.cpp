@@ -9,7 +9,6 @@
 #include <opencv2/imgproc.hpp>
 
 #include "cli.h"
-#include "run_harness.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
@@ -20,6 +19,7 @@
 #include "sketchnav/ros/outputs.h"
 #include "sketchnav/ros/route_server.h"
 #include "sketchnav/ros/sim_bridge.h"
+#include "sketchnav/run/run.h"
 #include "sketchnav/servo/turn_law.h"
 
 namespace sketchnav::app {
@@ -210,8 +210,8 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     ros::RosParams rp;
     applyConfig(rp, c, "ros");
     // Every setting checked before anything waits for a topic: a typo fails at once.
-    const RunSettings rs = runSettingsFrom(c);
-    c.requireAllUsedExcept(driverSettingPrefixes());
+    const run::RunSettings rs = run::runSettingsFrom(c);
+    c.requireAllUsedExcept(run::driverSettingPrefixes());
     ros::startWatchdog(rp);
     // The executive grabs a frame once nav.camera_period_s - tick_s / 2 has passed since the
     // last: such a frame wakes the control loop instead of waiting for its next tick.
@@ -263,7 +263,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
       RouteView view;
       view.out = &outputs;
       view.server = server.get();
-      RunOptions o;
+      run::RunOptions o;
       o.sketch = goal.sketch;
       o.model = goal.model.empty() ? args.get("model") : goal.model;
       o.landmark_dir = args.get("landmarks");
@@ -303,7 +303,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
       o.stop_requested = [&] { return (server && server->cancelRequested()) || !ros::ok(); };
       log::info("ros", "route started", {{"sketch", o.sketch}, {"from", goal.source}});
       outputs.status("starting " + o.sketch);
-      Json s = runNavigation(o);
+      Json s = run::runNavigation(o);
       const std::string f = ros::fault();
       s["ros"] = {{"fault", f},
                   {"signal", ros::signalReceived()},

@@ -3,9 +3,10 @@
 #include <iostream>
 
 #include "cli.h"
-#include "run_harness.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/run/run.h"
+#include "sketchnav/run/summary.h"
 
 namespace sketchnav::app {
 namespace {
@@ -37,7 +38,7 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
               "run simulator-free on a recorded rawlog or ROS bag (from --record, or a bag of ros "
               "sim's topics)");
   if (!args.parse(argv)) return 0;
-  RunOptions o;
+  run::RunOptions o;
   o.world = args.get("world");
   o.sketch = args.get("sketch");
   o.model = args.get("model");
@@ -68,38 +69,33 @@ int runRun(const std::vector<std::string>& argv, GlobalOptions& g) {
   o.config = g.config;
   o.out_dir = makeOutputDir(args.get("out"));
   o.progress = true;
-  const Json summary = runNavigation(o);
+  const run::RunSummary summary = run::RunSummary::fromJson(run::runNavigation(o));
   if (g.json) {
-    printJson(summary);
+    printJson(summary.json);
   } else {
-    std::cout << (summary["success"].get<bool>() ? "success" : "FAILED") << ": "
-              << summary["reason"].get<std::string>() << "\n"
-              << "time " << summary["time_s"].get<double>() << " s (real-time factor "
-              << summary["real_time_factor"].get<double>() << "), path "
-              << summary["path_length_m"].get<double>() << " m\n";
+    std::cout << (summary.success ? "success" : "FAILED") << ": " << summary.reason << "\n"
+              << "time " << summary.time_s << " s (real-time factor " << summary.real_time_factor
+              << "), path " << summary.path_length_m << " m\n";
     // Simulation only: which part of a goal error is the robot's and which the drawing's.
-    if (summary.contains("diagnostics")) {
-      const Json& d = summary["diagnostics"];
+    if (const auto& d = summary.diagnostics) {
       char buf[200];
-      std::snprintf(buf, sizeof buf, "ground truth: odometry off %.2f m",
-                    d.value("odometry_error_m", 0.0));
+      std::snprintf(buf, sizeof buf, "ground truth: odometry off %.2f m", d->odometry_error_m);
       std::cout << buf;
-      if (d.contains("goal_estimate_error_m")) {
-        std::snprintf(buf, sizeof buf, "; goal estimate off %.2f m",
-                      d["goal_estimate_error_m"].get<double>());
+      if (d->goal_estimate_error_m) {
+        std::snprintf(buf, sizeof buf, "; goal estimate off %.2f m", *d->goal_estimate_error_m);
         std::cout << buf;
       }
-      if (d.contains("sketch_goal_error_m")) {
+      if (d->sketch_goal_error_m) {
         std::snprintf(buf, sizeof buf,
                       "; the sketch alone puts the goal %.2f m off (every landmark fixed exactly)",
-                      d["sketch_goal_error_m"].get<double>());
+                      *d->sketch_goal_error_m);
         std::cout << buf;
       }
       std::cout << "\n";
     }
     std::cout << "outputs in " << o.out_dir << "\n";
   }
-  return summary["success"].get<bool>() ? 0 : 1;
+  return summary.success ? 0 : 1;
 }
 
 const CommandRegistration reg(

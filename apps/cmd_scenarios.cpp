@@ -12,14 +12,15 @@
 #include <sstream>
 
 #include "cli.h"
-#include "run_harness.h"
-#include "scenario.h"
 #include "scenario_gen.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
+#include "sketchnav/run/judge.h"
+#include "sketchnav/run/run.h"
+#include "sketchnav/run/scenario.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world.h"
 
@@ -195,8 +196,8 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   const auto classes = mapsketch::landmarkClasses(landmark_dir);
   const bool run = args.flagSet("run");
   if (run) {
-    runSettingsFrom(g.config);
-    g.config.requireAllUsedExcept(driverSettingPrefixes());
+    run::runSettingsFrom(g.config);
+    g.config.requireAllUsedExcept(run::driverSettingPrefixes());
   }
   const std::string out = makeOutputDir(args.get("out"));
 
@@ -212,7 +213,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
     // every sketched landmark fixed exactly (sketchGoalErrorM).
     const sim::World w = sim::worldFromJson(s.world, s.name, resourceDir());
     const auto route = mapsketch::toRoute(mapsketch::sketchFromJson(s.sketch, s.name));
-    const auto e = sketchGoalErrorM(w, route, outlier_m);
+    const auto e = run::sketchGoalErrorM(w, route, outlier_m);
     Json kinds = Json::array();
     for (const auto& er : s.errors) kinds.push_back(er.kind);
     index.push_back({{"name", s.name},
@@ -248,19 +249,19 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   }
 
   // --- benchmark -----------------------------------------------------------------------------
-  const std::string model = ensureModel(args.get("model"), true);
+  const std::string model = run::ensureModel(args.get("model"), true);
   std::string config_file;
   if (!g.config.keys().empty()) {
     config_file = out + "/config.json";
     std::ofstream(config_file) << g.config.toJson().dump(2) << "\n";
   }
-  std::vector<ScenarioSpec> specs;
+  std::vector<run::ScenarioSpec> specs;
   std::vector<size_t> spec_of;  // scenario index of each spec
   for (size_t i = 0; i < scen.size(); ++i) {
     const std::string dir = out + "/runs/" + scen[i].name;
     if (args.flagSet("reuse") && fs::exists(dir + "/summary.json")) continue;
     fs::create_directories(dir);
-    ScenarioSpec sp;
+    run::ScenarioSpec sp;
     sp.label = scen[i].name;
     sp.world_file = out + "/" + scen[i].name + ".world.json";
     sp.sketch_file = out + "/" + scen[i].name + ".sketch.json";
@@ -274,7 +275,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   }
   std::cerr << "scenarios: running " << specs.size() << " of " << scen.size() << ", " << jobs
             << " in parallel; outputs in " << out << "/runs\n";
-  runScenarios(specs, jobs, true);
+  run::runScenarios(specs, jobs, true);
 
   Json rows = Json::array();
   Agg all;
@@ -286,7 +287,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
     Json kinds = Json::array();
     for (const auto& e : s.errors) kinds.push_back(e.kind);
     r["errors"] = kinds;
-    const ScenarioResult res = readRunFolder(dir);
+    const run::ScenarioResult res = run::readRunFolder(dir);
     const Json& sm = res.summary;
     const sim::World w = sim::worldFromJson(s.world, s.name, resourceDir());
     r["ran"] = res.ran;

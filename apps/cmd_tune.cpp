@@ -13,12 +13,12 @@
 #include <sstream>
 
 #include "cli.h"
-#include "exp_variants.h"
 #include "plot.h"
-#include "run_harness.h"
-#include "scenario.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/run/experiments.h"
+#include "sketchnav/run/run.h"
+#include "sketchnav/run/scenario.h"
 #include "sketchnav/servo/turn_law.h"
 
 namespace sketchnav::app {
@@ -219,13 +219,13 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
     max_time = args.getDouble("max-time");
     if (!(max_time > 0)) throw InputError("--max-time must be positive");
   }
-  std::vector<Variant> scen;
-  for (const auto& n : args.getList("scenarios")) scen.push_back(makeVariant(n));
-  const SketchNoise noise = sketchNoiseFrom(g.config);
+  std::vector<run::Variant> scen;
+  for (const auto& n : args.getList("scenarios")) scen.push_back(run::makeVariant(n));
+  const run::SketchNoise noise = run::sketchNoiseFrom(g.config);
   // The runs' settings (every run setting; the runs apply them again): a typo fails here, and
   // --param must name one of them.
-  runSettingsFrom(g.config);
-  g.config.requireAllUsedExcept(driverSettingPrefixes());
+  run::runSettingsFrom(g.config);
+  g.config.requireAllUsedExcept(run::driverSettingPrefixes());
   {
     const auto known = g.config.knownKeys();
     if (std::find(known.begin(), known.end(), param) == known.end())
@@ -233,20 +233,20 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
                        closestKey(param, known) + "'?)");
   }
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model = ensureModel(args.get("model"), true);
-  const std::string config_file = writeBatchConfig(g.config, out);
-  std::vector<ScenarioSpec> specs;
+  const std::string model = run::ensureModel(args.get("model"), true);
+  const std::string config_file = run::writeBatchConfig(g.config, out);
+  std::vector<run::ScenarioSpec> specs;
   std::vector<size_t> value_of;
   for (size_t si = 0; si < scen.size(); ++si) {
     const auto& v = scen[si];
     const std::string sdir = out + "/" + v.name;
-    const std::string wf = writeVariantWorld(v, sdir);
+    const std::string wf = run::writeVariantWorld(v, sdir);
     for (int k = 0; k < seeds; ++k) {
       const int seed = seed0 + k;
       const std::string sk = sdir + "/sketch-" + std::to_string(seed) + ".json";
-      writeVariantSketch(v, noise, seed, sk);
+      run::writeVariantSketch(v, noise, seed, sk);
       for (size_t vi = 0; vi < values.size(); ++vi) {
-        ScenarioSpec s;
+        run::ScenarioSpec s;
         std::ostringstream val;
         val << values[vi];
         s.label = v.name + " " + param + "=" + val.str() + " seed " + std::to_string(seed);
@@ -266,7 +266,7 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
   std::cerr << "tune: " << values.size() << " values x " << scen.size() << " scenarios x " << seeds
             << " seeds = " << specs.size() << " runs, " << jobs << " in parallel; outputs in "
             << out << "\n";
-  const auto results = runScenarios(specs, jobs, true);
+  const auto results = run::runScenarios(specs, jobs, true);
 
   std::vector<Row> rows(values.size());
   for (size_t vi = 0; vi < values.size(); ++vi) {

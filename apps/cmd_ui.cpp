@@ -2,7 +2,7 @@
 // unless told otherwise; see doc/ui.md.
 // Eigen-using headers first: a macro pulled in by httplib.h (server.h) breaks Eigen's headers.
 // clang-format off
-#include "run_harness.h"
+#include "sketchnav/run/run.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
@@ -51,26 +51,10 @@ bool endsWith(const std::string& s, const std::string& suffix) {
 // The sketch a run uses when the page names none (as runNavigation picks it).
 std::string sketchFor(const ui::RunRequest& rq) {
   if (!rq.sketch.empty()) return rq.sketch;
-  const std::string w = rq.hardware() ? "lab" : rq.world;
-  if (w.find('/') != std::string::npos || endsWith(w, ".json")) {
-    if (endsWith(w, ".world.json")) return w.substr(0, w.size() - 11) + ".sketch.json";
-    return "";
-  }
-  return resourcePath("sketches/" + w + ".sketch.json");
+  return run::defaultSketchPath(rq.hardware() ? "lab" : rq.world);
 }
 
 Json worldGeometry(const std::string& world);
-
-// The drawn path in the route frame (metres; the frame of Route::guide_points_m).
-std::vector<Eigen::Vector2d> sketchPathInRoute(const mapsketch::Sketch& sk,
-                                               const mapsketch::Route& route) {
-  std::vector<Eigen::Vector2d> out;
-  out.reserve(sk.path.size());
-  for (const auto& p : sk.path)
-    out.push_back(route.start_m + Eigen::Vector2d((p.x() - sk.start.x()) * route.scale_m_per_px,
-                                                  -(p.y() - sk.start.y()) * route.scale_m_per_px));
-  return out;
-}
 
 // The route as the executive places it now (its SectionTracker's route -> odometry
 // alignment, refitted at landmark fixes), for the run page's map. Called after every step;
@@ -148,7 +132,7 @@ Json mapGeometry(const ui::RunRequest& rq) {
       return V(c * d.x() - s * d.y(), s * d.x() + c * d.y());
     };
     Json path = Json::array();
-    for (const auto& p : sketchPathInRoute(sk, route)) path.push_back(pt(toOdom(p)));
+    for (const auto& p : run::drawnPathInRoute(sk, route)) path.push_back(pt(toOdom(p)));
     Json guides = Json::array(), lms = Json::array();
     for (const auto& p : route.guide_points_m) guides.push_back(pt(toOdom(p)));
     for (const auto& sec : route.sections)
@@ -247,7 +231,7 @@ Json cameraOnly(const ui::RunRequest& rq, const ui::RunHooks& h) {
 // The run page's runner: `sketchnav run` (runNavigation) in real time, reporting to the page.
 Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::string& landmarks,
                  const std::string& model_cache) {
-  RunOptions o;
+  run::RunOptions o;
   o.world = rq.world;
   o.sketch = rq.sketch;
   o.robot = rq.robot;
@@ -297,7 +281,7 @@ Json runFromPage(const ui::RunRequest& rq, const ui::RunHooks& h, const std::str
     log::warn("ui", "no map for the run page", {{"error", e.what()}});
     h.on_map(Json::object());
   }
-  return runNavigation(o);
+  return run::runNavigation(o);
 }
 
 std::vector<std::string> filesEndingIn(const std::string& dir, const std::string& suffix) {

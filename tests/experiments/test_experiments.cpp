@@ -9,15 +9,25 @@
 #include <map>
 #include <set>
 
-#include "exp_variants.h"
 #include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
+#include "sketchnav/run/experiments.h"
 #include "sketchnav/sim/world.h"
 
 namespace sketchnav::app {
+// The experiment model is the run library's (run/experiments.h); the plot writer is the app's.
+using run::makeSketch;
+using run::makeVariant;
+using run::SketchNoise;
+using run::summariseFailures;
+using run::TrialFailure;
+using run::trialFailure;
+using run::Variant;
+using run::variantNames;
+using run::writeVariantSketch;
 namespace {
 
 int landmarkCount(const Variant& v) {
@@ -173,8 +183,9 @@ TEST(Plot, ConfusionMatrixShadesByRowShareAndOutlinesTheRightAnswers) {
 }  // namespace sketchnav::app
 
 TEST(ExperimentsReport, FailuresCountByCodeWithTheirDetails) {
-  using sketchnav::app::TrialFailure;
-  using sketchnav::app::trialFailure;
+  using sketchnav::run::summariseFailures;
+  using sketchnav::run::TrialFailure;
+  using sketchnav::run::trialFailure;
   const sketchnav::Json short1 = {{"distance_to_goal_m", 0.613}};
   const sketchnav::Json short2 = {{"distance_to_goal_m", 0.82}};
   const sketchnav::Json hit = {{"collision_with", "pedestrian left"}};
@@ -189,11 +200,11 @@ TEST(ExperimentsReport, FailuresCountByCodeWithTheirDetails) {
       trialFailure("lost", "something else entirely", {}),
       // A summary older than the code is counted by its reason.
       trialFailure("", "an old reason 1.5 m", {})};
-  EXPECT_EQ(sketchnav::app::summariseFailures(failures),
+  EXPECT_EQ(summariseFailures(failures),
             "2x stopped short of the goal [m] (0.61, 0.82); 1x collision (pedestrian left); "
             "2x lost (landmarks in a row not found); 1x an old reason 1.5 m");
   // Long reasons are not cut (the report's row once was, at 300 characters).
   std::vector<TrialFailure> many(5, TrialFailure{"", std::string(120, 'x'), ""});
-  EXPECT_EQ(sketchnav::app::summariseFailures(many), "5x " + std::string(120, 'x'));
-  EXPECT_EQ(sketchnav::app::summariseFailures({}), "");
+  EXPECT_EQ(summariseFailures(many), "5x " + std::string(120, 'x'));
+  EXPECT_EQ(summariseFailures({}), "");
 }

@@ -1,10 +1,10 @@
 # Closed-loop navigation runs in the simulator (issue #7): short worlds under fixtures/, fixed
 # seeds, assertions on outcome and clearance. They run exactly what `sketchnav run` runs
-# (apps/run_harness), with the demo landmark model trained once into the build tree.
-if(TARGET sketchnav_runharness)
+# (run/: sketchnav::run), with the demo landmark model trained once into the build tree.
+if(TARGET sketchnav::run)
   sketchnav_add_test(test_integration_nav
     SOURCES ${CMAKE_CURRENT_LIST_DIR}/test_closed_loop.cpp
-    LINK sketchnav_runharness sketchnav::hw
+    LINK sketchnav::run sketchnav::hw
     LABELS integration
     TIMEOUT 900)
   if(TARGET test_integration_nav)

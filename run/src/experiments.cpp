@@ -1,4 +1,4 @@
-#include "exp_variants.h"
+#include "sketchnav/run/experiments.h"
 
 #include <algorithm>
 #include <cctype>
@@ -14,7 +14,7 @@
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/route.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 namespace {
 
 using V2 = Eigen::Vector2d;
@@ -357,4 +357,4 @@ std::string writeBatchConfig(const Config& config, const std::string& out) {
   return path;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

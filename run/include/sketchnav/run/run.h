@@ -1,29 +1,25 @@
 #pragma once
-// `sketchnav run` as a function, shared by the command and the closed-loop integration tests:
-// opens the devices (the simulator by default, or hardware URIs), loads the sketch -> route
-// and the landmark model (trained on first use and cached), runs the navigation executive and
-// writes summary.json, trajectory.png, events.jsonl and telemetry.csv.
+// `sketchnav run` as a function, shared by the command, `sketchnav ui`, `sketchnav ros nav` and
+// the closed-loop integration tests: opens the devices from URIs (the simulator by default, or
+// hardware, or a recording), loads the sketch -> route and the landmark model (trained on first
+// use and cached), runs the navigation executive, judges a simulated run against ground truth
+// (judge.h) and writes the run folder: summary.json, trajectory.png, events.jsonl and
+// telemetry.csv (run_folder.h).
 #include <functional>
 #include <memory>
-#include <optional>
 #include <string>
+#include <vector>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/mapsketch/route.h"
+#include "sketchnav/mapsketch/sketch.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/perception.h"
 #include "sketchnav/sim/simulator.h"
 
-namespace sketchnav::sim {
-struct World;
-}
-namespace sketchnav::mapsketch {
-struct Route;
-}
-
-namespace sketchnav::app {
+namespace sketchnav::run {
 
 struct RunOptions {
   std::string world = "lab";  // sim: a world name in share/worlds or a world file
@@ -77,38 +73,27 @@ Json runSettingsJson(const RunSettings& settings, bool with_sim = true);
 /// The prefixes of device drivers' settings, applied only when a device is opened.
 const std::vector<std::string>& driverSettingPrefixes();
 
-/// summary.json's "failure", the code beside its "reason": "" when the run succeeded,
-/// "collision", "short_of_goal" (the executive arrived, ground truth puts the robot outside the
-/// goal region), else the executive's nav::FailureCode ("lost", "timeout", "no_progress",
-/// "safety_stop", "stopped").
-std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary& es);
-
-/// Runs one navigation. Returns the summary object (what summary.json holds). Throws
+/// Runs one navigation. Returns the summary object (what summary.json holds; summary.h reads
+/// its figures typed: RunSummary::fromJson). Throws
 /// InputError for bad options / files, RuntimeError when a device cannot be opened.
 Json runNavigation(const RunOptions& options);
 
-/// The verdict of a simulated run (doc/navigation.md): success means the robot's centre is in
-/// the goal region and nothing was hit (ground truth), whatever the executive concluded; the
-/// executive's own verdict goes beside it (summary.json "executive_success"). The reason says
-/// which applied: a collision, a route completed short of the goal, the goal reached (with the
-/// executive's failure when it failed there), or the executive's reason.
-struct RunVerdict {
-  bool success = false;
-  std::string reason;
-};
-RunVerdict judgeSimulatedRun(bool executive_succeeded, const std::string& executive_reason,
-                             bool at_goal, bool collided, const std::string& collided_with,
-                             double to_goal_m);
+/// Whether RunOptions::world names a world file (a path, or a name ending in ".json") rather
+/// than a world in share/worlds.
+bool isWorldFile(const std::string& world);
 
-/// How far the sketch alone puts the goal [m]: where the navigation's refit of `route`, with
-/// every sketched landmark fixed exactly where `w` has it (nav::goalFromExactFixes, outlier
-/// gate `fit_outlier_m`), maps the drawn goal, from the goal's centre. None when fewer than two
-/// sketched landmarks are in the world. Perfect perception and odometry cannot do better with
-/// this refit.
-std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Route& route,
-                                       double fit_outlier_m);
+/// The sketch a run over `world` (RunOptions::world) uses when it is given none: for a world
+/// file "x.world.json", "x.sketch.json" beside it (not checked to exist); for a world name, the
+/// shipped share/sketches/<name>.sketch.json (RuntimeError naming it when there is none); ""
+/// for a world file of another name.
+std::string defaultSketchPath(const std::string& world);
+
+/// The path drawn on `sketch` (canvas pixels) in the frame of `route` = toRoute(sketch) [m]
+/// (Route::guide_points_m's frame: the sketch's start at route.start_m, y up).
+std::vector<Eigen::Vector2d> drawnPathInRoute(const mapsketch::Sketch& sketch,
+                                              const mapsketch::Route& route);
 
 /// The landmark model cache file for a landmark set folder (keyed by its content hash).
 std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir);
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

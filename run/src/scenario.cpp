@@ -1,4 +1,4 @@
-#include "scenario.h"
+#include "sketchnav/run/scenario.h"
 
 #include <fcntl.h>
 #include <signal.h>
@@ -16,12 +16,14 @@
 #include <sstream>
 #include <thread>
 
-#include "run_harness.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/landmarks/model.h"
+#include "sketchnav/run/run.h"
+#include "sketchnav/run/run_folder.h"
+#include "sketchnav/run/summary.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 namespace fs = std::filesystem;
 
 std::string selfExecutable() {
@@ -48,28 +50,6 @@ std::string ensureModel(const std::string& model, bool progress) {
 }
 
 namespace {
-
-std::vector<std::string> splitCsv(const std::string& line) {
-  std::vector<std::string> out;
-  std::string cell;
-  std::istringstream in(line);
-  while (std::getline(in, cell, ',')) out.push_back(cell);
-  if (!line.empty() && line.back() == ',') out.push_back("");
-  return out;
-}
-
-double num(const std::vector<std::string>& row, int i) {
-  if (i < 0 || i >= static_cast<int>(row.size()) || row[i].empty()) return NAN;
-  try {
-    return std::stod(row[i]);
-  } catch (...) {
-    return NAN;
-  }
-}
-
-double jnum(const Json& j, const char* key, double def = 0) {
-  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : def;
-}
 
 // Runs one child; returns its exit status (-1 when it could not start).
 int spawnRun(const ScenarioSpec& s, const std::string& exe) {
@@ -135,46 +115,31 @@ ScenarioResult readRunFolder(const std::string& dir) {
     r.failure = "no_summary";
     return r;
   }
-  const Json& s = r.summary;
+  const RunSummary s = RunSummary::fromJson(r.summary);
   r.ran = true;
-  r.success = s.value("success", false);
-  r.reason = s.value("reason", "");
-  r.failure = s.value("failure", "");
-  r.time_s = jnum(s, "time_s");
-  r.path_m = jnum(s, "path_length_m");
-  r.min_clearance_m = jnum(s, "min_clearance_m", NAN);
-  r.wall_s = jnum(s, "wall_time_s");
-  if (s.contains("deviation_m") && s["deviation_m"].is_object()) {
-    r.deviation_mean_m = jnum(s["deviation_m"], "mean", NAN);
-    r.deviation_max_m = jnum(s["deviation_m"], "max", NAN);
-  }
+  r.success = s.success;
+  r.reason = s.reason;
+  r.failure = s.failure;
+  r.time_s = s.time_s;
+  r.path_m = s.path_length_m;
+  r.min_clearance_m = s.min_clearance_m;
+  r.wall_s = s.wall_time_s;
+  r.deviation_mean_m = s.deviation_mean_m;
+  r.deviation_max_m = s.deviation_max_m;
   // Telemetry: the true poses and the commanded yaw rate.
-  std::ifstream tc(dir + "/telemetry.csv");
-  std::string line;
-  if (tc && std::getline(tc, line)) {
-    const auto head = splitCsv(line);
-    auto col = [&](const std::string& n) {
-      for (size_t i = 0; i < head.size(); ++i)
-        if (head[i] == n) return static_cast<int>(i);
-      return -1;
-    };
-    const int cx = col("true_x"), cy = col("true_y"), ct = col("true_theta"), cw = col("w_cmd");
-    int last_sign = 0, changes = 0;
-    while (std::getline(tc, line)) {
-      const auto row = splitCsv(line);
-      const double x = num(row, cx), y = num(row, cy), th = num(row, ct), w = num(row, cw);
-      if (std::isfinite(x) && std::isfinite(y))
-        r.trajectory.push_back({x, y, std::isfinite(th) ? th : 0.0});
-      // A sign change counts when |w| is clearly non-zero on both sides (1e-3 rad/s), so
-      // going straight between two turns the same way is not an oscillation.
-      if (std::isfinite(w) && std::abs(w) > 1e-3) {
-        const int sg = w > 0 ? 1 : -1;
-        if (last_sign != 0 && sg != last_sign) ++changes;
-        last_sign = sg;
-      }
+  int last_sign = 0, changes = 0;
+  for (const TelemetryRecord& t : readTelemetryCsv(dir + "/telemetry.csv")) {
+    if (t.truth) r.trajectory.push_back(*t.truth);
+    // A sign change counts when |w| is clearly non-zero on both sides (1e-3 rad/s), so
+    // going straight between two turns the same way is not an oscillation.
+    const double w = t.w_cmd;
+    if (std::isfinite(w) && std::abs(w) > 1e-3) {
+      const int sg = w > 0 ? 1 : -1;
+      if (last_sign != 0 && sg != last_sign) ++changes;
+      last_sign = sg;
     }
-    r.oscillation_per_m = r.path_m > 0.1 ? changes / r.path_m : 0.0;
   }
+  r.oscillation_per_m = r.path_m > 0.1 ? changes / r.path_m : 0.0;
   return r;
 }
 
@@ -219,4 +184,4 @@ std::vector<ScenarioResult> runScenarios(const std::vector<ScenarioSpec>& specs,
   return results;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

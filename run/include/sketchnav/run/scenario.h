@@ -1,18 +1,19 @@
 #pragma once
-// Running simulated navigation scenarios in bulk (for `experiments` and `tune`).
+// Running simulated navigation scenarios in bulk (for `experiments`, `tune` and `scenarios`).
 //
-// One scenario = one `sketchnav run` (run_harness.h: runNavigation, the nav engineer's
-// harness, reused as is) over a world file and a sketch file with a seed and settings. Each
-// runs in its own child process (this executable, `run` subcommand) so several run in
-// parallel without sharing state, and a crash or hang of one trial is that trial's failure,
-// not the sweep's. Results come from the run's summary.json and telemetry.csv.
+// One scenario = one `sketchnav run` (run.h: runNavigation, reused as is) over a world file
+// and a sketch file with a seed and settings. Each runs in its own child process (the running
+// executable's `run` subcommand, so only the `sketchnav` command can call runScenarios) so
+// several run in parallel without sharing state, and a crash or hang of one trial is that
+// trial's failure, not the sweep's. Results come from the run folder: summary.json and
+// telemetry.csv.
 #include <string>
 #include <vector>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/types.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 
 struct ScenarioSpec {
   std::string label;              // for progress lines ("exp3-6 #2")
@@ -30,7 +31,7 @@ struct ScenarioResult {
   bool ran = false;      // the child produced a summary (false: it crashed / bad input)
   bool success = false;  // reached the goal without collision (simulator ground truth)
   std::string reason;
-  // summary.json's "failure" code (run_harness.h failureCode): "" on success; "no_summary" or
+  // summary.json's "failure" code (judge.h failureCode): "" on success; "no_summary" or
   // "crashed" when the child wrote no readable summary; "" from a summary older than the code.
   std::string failure;
   double time_s = 0;                                 // simulated time to the end of the run
@@ -58,4 +59,4 @@ std::vector<ScenarioResult> runScenarios(const std::vector<ScenarioSpec>& specs,
 /// Parses a run folder (summary.json + telemetry.csv) into a result.
 ScenarioResult readRunFolder(const std::string& dir);
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

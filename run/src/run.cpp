@@ -1,4 +1,4 @@
-#include "run_harness.h"
+#include "sketchnav/run/run.h"
 
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
@@ -35,12 +35,16 @@
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/nav/sections.h"
+#include "sketchnav/run/judge.h"
+#include "sketchnav/run/run_folder.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world_check.h"
 
-namespace sketchnav::app {
+#include "frames.h"
+
+namespace sketchnav::run {
 namespace fs = std::filesystem;
 
 std::string modelCachePath(const std::string& landmark_dir, const std::string& cache_dir) {
@@ -114,22 +118,6 @@ void checkWorldForRun(const sim::World& w, const landmarks::LandmarkModel& model
   for (const auto& i : issues) log::warn("run", i.text(origin));
 }
 
-bool looksLikePath(const std::string& s) {
-  return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
-}
-
-// Odometry frame <-> world frame in simulation: the odometry frame starts at the world's start
-// pose (origin there, +x along its heading).
-Eigen::Vector2d odomToWorld(const hw::Pose2D& start, const Eigen::Vector2d& o) {
-  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
-  return {start.x + cs * o.x() - ss * o.y(), start.y + ss * o.x() + cs * o.y()};
-}
-Eigen::Vector2d worldToOdom(const hw::Pose2D& start, const Eigen::Vector2d& p) {
-  const double cs = std::cos(start.theta), ss = std::sin(start.theta);
-  const Eigen::Vector2d d(p.x() - start.x, p.y() - start.y);
-  return {cs * d.x() + ss * d.y(), -ss * d.x() + cs * d.y()};
-}
-
 // Route frame -> world frame for drawing: the route's start at the world start pose, facing
 // along the first section (the executive's initial alignment).
 struct RouteToWorld {
@@ -149,13 +137,9 @@ class RunObserver final : public nav::ExecutiveObserver {
       : progress_(progress), sim_(sim), sections_(sections) {
     if (!out.empty()) {
       events_.open(out + "/events.jsonl");
-      tele_.open(out + "/telemetry.csv");
-      if (!events_ || !tele_) throw RuntimeError("cannot write run files in " + out);
-      // Header flushed at open and every row written whole and flushed (one write()): a run
-      // killed at any moment leaves telemetry.csv readable to its last whole row.
-      tele_ << "t,odom_x,odom_y,odom_theta,true_x,true_y,true_theta,v_cmd,w_cmd,servo_error,"
-               "mode,turn,section,landmark,front_free_m\n"
-            << std::flush;
+      // (The telemetry writer flushes its header at open and writes every row whole.)
+      const bool tele_ok = tele_.open(out + "/telemetry.csv");
+      if (!events_ || !tele_ok) throw RuntimeError("cannot write run files in " + out);
     }
   }
   std::vector<hw::Pose2D> odom;  // for hardware runs' trajectory
@@ -219,19 +203,7 @@ class RunObserver final : public nav::ExecutiveObserver {
     if (sim_) truth = sim_->truePose();
     last_truth = truth;
     odom.push_back(r.odom);
-    if (tele_.is_open()) {
-      std::ostringstream row;
-      row << r.t << ',' << r.odom.x << ',' << r.odom.y << ',' << r.odom.theta << ',';
-      if (sim_)
-        row << truth.x << ',' << truth.y << ',' << truth.theta << ',';
-      else
-        row << ",,,";
-      row << r.v_cmd << ',' << r.w_cmd << ',';
-      if (std::isfinite(r.servo_error)) row << r.servo_error;
-      row << ',' << nav::toString(r.mode) << ',' << servo::toString(r.turn) << ',' << r.section
-          << ',' << r.landmark << ',' << r.front_free_m << '\n';
-      tele_ << row.str() << std::flush;
-    }
+    tele_.write(r, sim_ ? &truth : nullptr);
     if (progress_ && r.t >= next_progress_) {
       next_progress_ = r.t + 5.0;
       char buf[200];
@@ -252,7 +224,8 @@ class RunObserver final : public nav::ExecutiveObserver {
   bool progress_;
   sim::Simulator* sim_;
   int sections_;
-  std::ofstream events_, tele_;
+  std::ofstream events_;
+  TelemetryWriter tele_;
   double next_progress_ = 0;
 };
 
@@ -286,11 +259,7 @@ void drawTrajectory(const std::string& path, const sim::World& world,
   sim::MapCanvas canvas(world, 40.0, 0.5, true);
   // The hand-drawn path as drawn (canvas px -> route frame -> world), solid.
   std::vector<Eigen::Vector2d> drawn;
-  for (const auto& p : sketch.path) {
-    const Eigen::Vector2d rp((p.x() - sketch.start.x()) * route.scale_m_per_px,
-                             -(p.y() - sketch.start.y()) * route.scale_m_per_px);
-    drawn.push_back(r2w(rp + route.start_m));
-  }
+  for (const auto& p : drawnPathInRoute(sketch, route)) drawn.push_back(r2w(p));
   canvas.drawPolyline(drawn, {0, 0, 0}, false, 2);
   // Where the sketch put the landmarks (hollow grey), next to the real ones the map shows.
   for (const auto& sec : route.sections)
@@ -310,19 +279,27 @@ void drawTrajectory(const std::string& path, const sim::World& world,
 
 }  // namespace
 
-std::optional<double> sketchGoalErrorM(const sim::World& w, const mapsketch::Route& route,
-                                       double fit_outlier_m) {
-  // The landmarks' true places in the odometry frame (the robot starts at its origin, facing
-  // +x), the refit of nav::goalFromExactFixes, and its goal back in the world. The scale bound
-  // is loose: fit after fit, the navigation's scale may move that far too.
-  std::map<std::string, Eigen::Vector2d> truth;
-  for (const auto& l : w.landmarks) truth[l.id] = worldToOdom(w.start, l.position);
-  nav::WeightedFitParams wp;
-  wp.outlier_m = fit_outlier_m;
-  wp.max_scale_change = 0.5;
-  const auto g = nav::goalFromExactFixes(route, truth, wp);
-  if (!g) return std::nullopt;
-  return (odomToWorld(w.start, *g) - w.goal.centre).norm();
+bool isWorldFile(const std::string& s) {
+  return s.find('/') != std::string::npos || (s.size() > 5 && s.substr(s.size() - 5) == ".json");
+}
+
+std::string defaultSketchPath(const std::string& world) {
+  if (!isWorldFile(world)) return resourcePath("sketches/" + world + ".sketch.json");
+  const std::string suffix = ".world.json";
+  if (world.size() > suffix.size() && world.substr(world.size() - suffix.size()) == suffix)
+    return world.substr(0, world.size() - suffix.size()) + ".sketch.json";
+  return "";
+}
+
+std::vector<Eigen::Vector2d> drawnPathInRoute(const mapsketch::Sketch& sketch,
+                                              const mapsketch::Route& route) {
+  std::vector<Eigen::Vector2d> out;
+  out.reserve(sketch.path.size());
+  for (const auto& p : sketch.path)
+    out.push_back(route.start_m +
+                  Eigen::Vector2d((p.x() - sketch.start.x()) * route.scale_m_per_px,
+                                  -(p.y() - sketch.start.y()) * route.scale_m_per_px));
+  return out;
 }
 
 RunSettings runSettingsFrom(const Config& c) {
@@ -362,39 +339,9 @@ Json runSettingsJson(const RunSettings& r, bool with_sim) {
   return j;
 }
 
-std::string failureCode(bool success, bool collided, const nav::ExecutiveSummary& es) {
-  if (success) return "";
-  if (collided) return "collision";
-  if (es.status == nav::RunStatus::Succeeded) return "short_of_goal";
-  const std::string code = nav::toString(es.failure);
-  return code.empty() ? "unknown" : code;
-}
-
 const std::vector<std::string>& driverSettingPrefixes() {
   static const std::vector<std::string> p = {"base.", "camera.", "laser.", "sonar."};
   return p;
-}
-
-RunVerdict judgeSimulatedRun(bool executive_ok, const std::string& executive_reason, bool at_goal,
-                             bool collided, const std::string& collided_with, double to_goal_m) {
-  RunVerdict v;
-  v.success = at_goal && !collided;
-  if (collided) {
-    v.reason = "collision with " + collided_with +
-               (executive_reason.empty() ? "" : "; " + executive_reason);
-  } else if (!at_goal && executive_ok) {
-    char b[160];
-    std::snprintf(b, sizeof b, "route completed but the robot stopped %.2f m from the goal",
-                  to_goal_m);
-    v.reason = b;
-  } else if (at_goal) {
-    v.reason = executive_ok
-                   ? "reached the goal"
-                   : "reached the goal region, but the executive failed: " + executive_reason;
-  } else {
-    v.reason = executive_reason;
-  }
-  return v;
 }
 
 Json runNavigation(const RunOptions& o) {
@@ -426,7 +373,7 @@ Json runNavigation(const RunOptions& o) {
   std::string world_name = o.world;
   if (!hardware) {
     std::string world_uri;
-    if (looksLikePath(o.world)) {
+    if (isWorldFile(o.world)) {
       if (!fs::exists(o.world)) throw InputError("--world " + o.world + ": no such file");
       world_uri = "sim://" + fs::absolute(o.world).string();
     } else {
@@ -490,15 +437,13 @@ Json runNavigation(const RunOptions& o) {
   // --- sketch -> route ----------------------------------------------------------------------
   std::string sketch_path = o.sketch;
   if (sketch_path.empty()) {
-    if (looksLikePath(o.world)) {
-      std::string p = o.world;
-      const std::string suffix = ".world.json";
-      if (p.size() > suffix.size() && p.substr(p.size() - suffix.size()) == suffix)
-        p = p.substr(0, p.size() - suffix.size()) + ".sketch.json";
-      if (!fs::exists(p)) throw InputError("--sketch is required (no " + p + ")");
-      sketch_path = p;
-    } else {
-      sketch_path = resourcePath("sketches/" + o.world + ".sketch.json");
+    sketch_path = defaultSketchPath(o.world);
+    if (isWorldFile(o.world)) {
+      // A world file not named *.world.json has no sketch beside it by convention: the file
+      // itself is tried, and loadSketch says why it is not a sketch.
+      if (sketch_path.empty()) sketch_path = o.world;
+      if (!fs::exists(sketch_path))
+        throw InputError("--sketch is required (no " + sketch_path + ")");
     }
   }
   const mapsketch::Sketch sketch = mapsketch::loadSketch(sketch_path);
@@ -773,4 +718,4 @@ Json runNavigation(const RunOptions& o) {
   return s;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

@@ -11,7 +11,7 @@
 
 #include "sketchnav/core/config.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 
 /// One experiment variant: the world it runs in and the guide line the user draws.
 struct Variant {
@@ -89,4 +89,4 @@ std::string summariseFailures(const std::vector<TrialFailure>& failures);
 /// its path, or "" when there are none.
 std::string writeBatchConfig(const Config& config, const std::string& out);
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run
