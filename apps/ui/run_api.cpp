@@ -321,7 +321,44 @@ void RunController::start(const RunRequest& request) {
       throw InputError("a run is already going: stop it first");
   }
   if (thread_.joinable()) thread_.join();  // the previous run has finished
-  if (opt_.check_request && !request.camera_only) opt_.check_request(request);
+  if (opt_.check_request && !request.camera_only) {
+    std::string why;
+    try {
+      opt_.check_request(request);
+    } catch (const std::exception& e) {
+      why = e.what();
+    }
+    if (!why.empty()) {
+      // Refused (the caller gets a 400 naming the file), and recorded like any run from the
+      // page: its folder with a summary saying why, and the state the page's card shows.
+      std::string run_dir;
+      Json summary = {{"success", false}, {"error", true}, {"refused", true}, {"reason", why},
+                      {"request", request.toJson()}};
+      try {
+        if (!opt_.runs_dir.empty()) run_dir = newRunDir(request);
+        if (!run_dir.empty()) {
+          summary["out_dir"] = run_dir;
+          writeFileAtomically((fs::path(run_dir) / "summary.json").string(),
+                              summary.dump(2) + "\n", "run summary");
+        }
+      } catch (const std::exception& w) {
+        log::error("ui", "cannot write the refused run's record", {{"error", w.what()}});
+      }
+      {
+        std::lock_guard<std::mutex> ll(live_->m);
+        live_->reset();
+        live_->run_dir = run_dir;
+        live_->request = request.toJson();
+        live_->hardware = request.hardware();
+        live_->summary = summary;
+        live_->status = "error";
+        live_->reason = why;
+        live_->end_mode = "error";
+      }
+      log::warn("ui", "run refused", {{"error", why}});
+      throw InputError(why);
+    }
+  }
   // The run's folder, as `sketchnav run` writes it: <runs_dir>/<UTC time>-<world or robot>.
   std::string run_dir;
   if (!opt_.runs_dir.empty() && !request.camera_only) run_dir = newRunDir(request);

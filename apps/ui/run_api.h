@@ -82,10 +82,11 @@ struct RunApiOptions {
   /// The objectness windows perception examined in a frame, drawn on the live view; computed
   /// on demand (only while someone watches), optional.
   std::function<std::vector<cv::Rect>(const cv::Mat&)> propose_windows;
-  /// Called by start() before anything starts (no run folder, no state change); throws
-  /// InputError for a request that cannot run, e.g. a world or sketch file that does not load,
-  /// so the page gets a 400 naming the file instead of a run that starts and then ends in an
-  /// error. Optional; not called for camera-only requests.
+  /// Called by start() before the run starts; throws for a request that cannot run, e.g. a
+  /// world or sketch file that does not load. start() then throws InputError with that text
+  /// (the page gets a 400 naming the file, not a run that starts and then ends in an error),
+  /// after recording the refusal as a run: its folder's summary.json and the state (status
+  /// "error", the reason). Optional; not called for camera-only requests.
   std::function<void(const RunRequest&)> check_request;
   /// Where every run started from the page gets its folder (<runs_dir>/<UTC time>); "" = no
   /// run folders.

@@ -506,6 +506,7 @@ TEST_F(RecognitionStage, TiltedViewsFindACartonTurnedAway) {
         PerceptionParams p;
         p.fovea = false;
         p.track.enabled = false;
+        p.tilt_confirm_frames = 0;  // one frame each: what the tilted view finds, reported at once
         p.window_tilts = 0;
         found_plain += at(LandmarkPerception(model_, p).observe(f, K, look));
         p.window_tilts = 1;
@@ -529,6 +530,7 @@ TEST_F(RecognitionStage, TiltedDetectionsAreReportedOnlyOnceConfirmed) {
   p.fovea = false;
   p.track.enabled = false;
   p.window_tilts = 1;
+  p.tilt_confirm_frames = 0;  // the search below looks at one frame per perception
   // A scene the tilted view alone finds (as in TiltedViewsFindACartonTurnedAway).
   hw::Frame f, moved;
   bool have = false;

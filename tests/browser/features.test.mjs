@@ -601,9 +601,17 @@ try {
   });
 
   await check('1: a run that cannot start leaves a record too; API errors are 4xx naming the field', async () => {
-    const r = await page.evaluate(async () => (await fetch('/api/run/start', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ mode: 'sim', world: 'corridor', sketch: '/nonexistent/x.sketch.json' }) })).json());
+    // Refused on the start request itself (issue 28: 400 naming the file, not a run answered
+    // 200 that then fails), and recorded like any run started from the page.
+    const r = await page.evaluate(async () => {
+      const res = await fetch('/api/run/start', { method: 'POST', headers: { 'Content-Type': 'application/json' }, body: JSON.stringify({ mode: 'sim', world: 'corridor', sketch: '/nonexistent/x.sketch.json' }) });
+      return { status: res.status, body: await res.json(), state: await (await fetch('/api/run/state')).json() };
+    });
+    assert.equal(r.status, 400, JSON.stringify(r.body));
+    assert.match(r.body.error, /nonexistent/);
+    assert.ok(r.state.run_dir, 'the refused run has a folder');
     await page.waitForFunction(() => !document.getElementById('run-card').hidden && /error/.test(document.getElementById('run-card').className), null, { timeout: 20000 });
-    const sum = JSON.parse(fs.readFileSync(path.join(r.run_dir, 'summary.json'), 'utf8'));
+    const sum = JSON.parse(fs.readFileSync(path.join(r.state.run_dir, 'summary.json'), 'utf8'));
     assert.equal(sum.success, false);
     assert.match(sum.reason, /nonexistent/);
     assert.match(await page.textContent('#run-card'), /nonexistent/);

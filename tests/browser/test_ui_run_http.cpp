@@ -357,14 +357,17 @@ TEST_F(UiRunHttp, RunnerErrorsAreShown) {
 }
 
 // Issue 28: a world that does not load used to be answered 200 and then reported as the
-// run's error; it is refused on the start request itself, naming the file, and nothing starts.
+// run's error; it is refused on the start request itself, naming the file. Nothing runs (the
+// runner is never called); the refusal is the run's state, as an error, for the page's card.
 TEST_F(UiRunHttp, AStartWhoseWorldDoesNotLoadIsA400NamingTheFile) {
   const auto r = post("/api/run/start", {{"world", "unloadable"}});
   ASSERT_EQ(r->status, 400);
   EXPECT_NE(r->body.find("unloadable.world.json"), std::string::npos) << r->body;
   const Json s = body(cli_->Get("/api/run/state"));
-  EXPECT_EQ(s["status"], "idle");
+  EXPECT_EQ(s["status"], "error");
+  EXPECT_NE(s["reason"].get<std::string>().find("unloadable.world.json"), std::string::npos);
   EXPECT_FALSE(s["active"].get<bool>());
+  EXPECT_EQ(log_->ticks.load(), 0) << "the runner ran";
   // The page is not stuck: a good request starts.
   EXPECT_EQ(post("/api/run/start", {{"world", "corridor"}})->status, 200);
 }
