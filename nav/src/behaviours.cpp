@@ -36,6 +36,27 @@ void SideLookParams::validate() const {
           "nav.side_look_max_bearing_deg", "must be in (0, 180]");
 }
 
+void DockParams::validate() const { require(dock_m >= 0, "nav.dock_m", "must be >= 0"); }
+
+std::optional<Docking::Proposal> Docking::propose(
+    const Polar& goal, double free_m, const std::function<std::optional<WayRound>()>& plan,
+    const DriveParams& drive) const {
+  double bearing = goal.bearing, left = goal.range;
+  if (free_m < goal.range) {
+    const auto way = plan ? plan() : std::nullopt;
+    // Only a short way round: a long one means the estimate sits behind a wall.
+    if (!way || way->length_m > p_.dock_m + 1.5) return std::nullopt;
+    bearing = way->bearing;
+    left = way->left_m;
+  }
+  Proposal out;
+  out.bearing = bearing;
+  // Slow in the last 0.6 m.
+  out.command = headFor(bearing, std::clamp(left / 0.6, 0.3, 1.0), drive);
+  out.command.turn = turnOf(bearing);
+  return out;
+}
+
 void FinalLookParams::validate() const {
   require(final_look_range_m >= 0, "nav.final_look_range_m", "must be >= 0 (0 = off)");
   require(final_look_s > 0, "nav.final_look_s", "must be > 0");

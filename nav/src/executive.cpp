@@ -23,6 +23,7 @@ void ExecutiveParams::validate() const {
   SideLookParams::validate();
   FinalLookParams::validate();
   RecoverParams::validate();
+  DockParams::validate();
   require(tick_s > 0.001 && tick_s <= 0.2, "nav.tick_s", "must be in (0.001, 0.2] s");
   require(camera_period_s > 0 && camera_period_s <= 2, "nav.camera_period_s",
           "must be in (0, 2] s");
@@ -33,7 +34,6 @@ void ExecutiveParams::validate() const {
   require(end_blocked_m >= 0, "nav.end_blocked_m", "must be >= 0");
   require(perception_period_s >= 0, "nav.perception_period_s", "must be >= 0");
   require(goal_stop_s >= 0, "nav.goal_stop_s", "must be >= 0");
-  require(dock_m >= 0, "nav.dock_m", "must be >= 0");
   require(detour_ahead_m > 0.5 && detour_ahead_m <= 10, "nav.detour_ahead_m",
           "must be in (0.5, 10] m");
   require(replan_s > 0, "nav.replan_s", "must be > 0");
@@ -185,6 +185,7 @@ struct Executive::Impl {
   // Stuck recovery: where the robot was stuck_s ago, and an escape under way.
   ProgressChecker progress_checker;
   Recovery recovery;
+  Docking docker;
   // Planned detour (or docking path) being followed, when it was planned and to where.
   PlannedPath detour;
   double detour_t = -1e300;
@@ -223,6 +224,7 @@ struct Executive::Impl {
         landmarks(tracker.route(), st.exec),
         progress_checker(st.exec.stuck_s, st.exec.stuck_m),
         recovery(st.exec, st.avoid.k_heading, st.exec.max_w),
+        docker(st.exec),
         follow(st.exec, st.exec, st.exec.approach_m),
         final_look(st.exec, st.exec.k_heading),
         side_look(st.exec, 0.0, st.exec.k_heading, st.exec.max_w),
@@ -603,37 +605,31 @@ struct Executive::Impl {
     // Without a free straight line (a goal in a doorway: the line grazes the door frame), a
     // path planned on the grid leads there, or as near as the robot fits.
     bool docking = false;
-    if (k + 1 == tracker.count() && prog.to_end_m <= s.exec.dock_m && !dev.ranges.empty()) {
+    if (k + 1 == tracker.count() && docker.near(prog.to_end_m) && !dev.ranges.empty()) {
       const Eigen::Vector2d goal = tracker.endOdom(k);
       const Polar pg = polarFrom(pose, goal);
       const double free =
           corridorFree(scanPoints(scans), pg.bearing,
                        s.avoid.robot_radius_m + s.avoid.corridor_margin_m, s.avoid.max_range_m);
-      double bearing = pg.bearing, left = pg.range;
-      bool ok = free >= pg.range;
-      if (!ok && s.exec.detour) {
-        const double b = planTowards(goal);
-        // Only a short way round: a long one means the estimate sits behind a wall.
-        if (std::isfinite(b) && detour.length_m <= s.exec.dock_m + 1.5) {
-          ok = true;
-          bearing = b;
-          left =
-              std::max(0.0, detour.length_m -
-                                (detour.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm());
-        }
-      }
-      if (ok) {
+      std::function<std::optional<Docking::WayRound>()> plan;
+      if (s.exec.detour)
+        plan = [&]() -> std::optional<Docking::WayRound> {
+          const double b = planTowards(goal);
+          if (!std::isfinite(b)) return std::nullopt;
+          const double from_start =
+              (detour.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm();
+          return Docking::WayRound{b, detour.length_m,
+                                   std::max(0.0, detour.length_m - from_start)};
+        };
+      if (const auto d = docker.propose(pg, free, plan, s.exec)) {
         docking = true;
         if (avoider.active()) {
           avoider.reset();
           endDetour("docking");
           event(event::AvoidEnd{DodgeSide::None, true});
         }
-        target_bearing = bearing;
-        // Slow in the last 0.6 m.
-        Command c = headFor(bearing, std::clamp(left / 0.6, 0.3, 1.0), s.exec);
-        c.turn = turnOf(bearing);
-        arb.propose(Behaviour::Dock, c);
+        target_bearing = d->bearing;
+        arb.propose(Behaviour::Dock, d->command);
       }
     }
     // Stuck (ProgressChecker): drive clear towards the most open direction (Recovery).

@@ -1,5 +1,5 @@
 // The executive's small behaviours on their own: heading for a bearing, following and looking,
-// looking to the side, the final look at the goal, and the stuck recovery.
+// looking to the side, the final look at the goal, the stuck recovery and docking.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -249,6 +249,54 @@ TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
   EXPECT_EQ(r.count(), 3);
 }
 
+// Docking: a free line to the goal is driven straight, slowing in the last 0.6 m; a blocked
+// line takes a short way round when one is planned, and nothing when the way is long or none.
+TEST(Docking, DrivesAFreeLineOrAShortWayRoundToTheGoal) {
+  const DriveParams drive;  // 0.3 m/s
+  const Docking dock(DockParams{});  // dock_m 1.5
+  const auto at = [](double range, double bearing) {
+    Polar g;
+    g.range = range;
+    g.bearing = bearing;
+    return g;
+  };
+  EXPECT_TRUE(dock.near(1.5));
+  EXPECT_FALSE(dock.near(1.6));
+  int planned = 0;
+  const auto way = [&](double bearing, double length, double left) {
+    return [&planned, bearing, length, left]() -> std::optional<Docking::WayRound> {
+      ++planned;
+      return Docking::WayRound{bearing, length, left};
+    };
+  };
+  // Free: straight at the goal, the plan never asked for.
+  auto d = dock.propose(at(1.2, 0.2), 3.0, way(-0.5, 1.0, 1.0), drive);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(planned, 0);
+  EXPECT_DOUBLE_EQ(d->bearing, 0.2);
+  EXPECT_NEAR(d->command.v, 0.3 * std::cos(0.2), 1e-12);  // 1.2 m left: full speed
+  EXPECT_EQ(d->command.turn, servo::Turn::Left);
+  d = dock.propose(at(0.3, 0.0), 3.0, nullptr, drive);  // 0.3 m left: half speed
+  ASSERT_TRUE(d);
+  EXPECT_NEAR(d->command.v, 0.15, 1e-12);
+  EXPECT_EQ(d->command.turn, servo::Turn::Straight);
+  d = dock.propose(at(0.05, 0.0), 3.0, nullptr, drive);  // never below 30 %
+  EXPECT_NEAR(d->command.v, 0.09, 1e-12);
+  // Blocked: the way round's bearing and what is left of it.
+  d = dock.propose(at(1.2, 0.0), 0.5, way(-0.3, 2.0, 0.6), drive);
+  ASSERT_TRUE(d);
+  EXPECT_EQ(planned, 1);
+  EXPECT_DOUBLE_EQ(d->bearing, -0.3);
+  EXPECT_NEAR(d->command.v, 0.3 * std::cos(0.3), 1e-12);
+  EXPECT_EQ(d->command.turn, servo::Turn::Right);
+  // A long way round (over dock_m + 1.5 m): the goal estimate is behind a wall.
+  EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, way(-0.3, 3.1, 3.0), drive));
+  // No way found, or no planning: no docking.
+  EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, [] { return std::optional<Docking::WayRound>(); },
+                            drive));
+  EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, nullptr, drive));
+}
+
 TEST(BehaviourParams, ValidateNamesTheSetting) {
   auto names = [](auto p, auto&& spoil, const char* key) {
     EXPECT_NO_THROW(p.validate());
@@ -271,6 +319,8 @@ TEST(BehaviourParams, ValidateNamesTheSetting) {
       FinalLookParams{}, [](FinalLookParams& p) { p.final_look_s = 0; }, "nav.final_look_s");
   names(
       RecoverParams{}, [](RecoverParams& p) { p.recover_m = 0; }, "nav.recover_m");
+  names(
+      DockParams{}, [](DockParams& p) { p.dock_m = -1; }, "nav.dock_m");
 }
 
 }  // namespace

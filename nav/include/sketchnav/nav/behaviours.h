@@ -5,6 +5,7 @@
 // ExecutiveParams derives from them) and reports what it did as an outcome — the command it
 // proposes (CommandArbiter decides), the event to report — and never touches the devices, the
 // run's status or the route.
+#include <functional>
 #include <optional>
 #include <set>
 #include <utility>
@@ -222,6 +223,46 @@ struct RecoverParams {
     b("recover_s", recover_s);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+/// Docking: close to the goal with a free straight line to it, the robot drives there
+/// directly. The goal is a place, often near a wall or in a doorway, where the avoider would
+/// keep dodging the wall behind it. Without a free straight line (a goal in a doorway: the line
+/// grazes the door frame), a short way round planned on the grid leads there, or as near as the
+/// robot fits; a long one means the goal estimate sits behind a wall, and there is no docking.
+struct DockParams {
+  double dock_m = 1.5;  // [m] this close to the goal, with a free line to it, drive straight there
+  template <class B>
+  void bind(B& b) {
+    b("dock_m", dock_m);
+  }
+  void validate() const;  // InputError "nav.dock_m = ...: ..."
+};
+
+class Docking {
+ public:
+  explicit Docking(DockParams p) : p_(p) {}
+  /// Within dock_m [m] of the goal along the route (`to_end_m`, on the last section).
+  bool near(double to_end_m) const { return to_end_m <= p_.dock_m; }
+
+  /// A way round to the goal planned on the grid: the bearing [rad, robot frame] to steer to,
+  /// its whole length [m] and what is left of it from the robot [m].
+  struct WayRound {
+    double bearing = 0, length_m = 0, left_m = 0;
+  };
+  struct Proposal {
+    double bearing = 0;  // [rad] robot frame: what it steers to
+    Command command;     // slowed in the last 0.6 m; turn = the bearing's side
+  };
+  /// `goal`: the goal from the robot; `free_m` [m]: how far the corridor towards it is free;
+  /// `plan`: plans a way round when the line is not free (null: no planning; it is called only
+  /// then). None: no docking this tick.
+  std::optional<Proposal> propose(const Polar& goal, double free_m,
+                                  const std::function<std::optional<WayRound>()>& plan,
+                                  const DriveParams& drive) const;
+
+ private:
+  DockParams p_;
 };
 
 class Recovery {

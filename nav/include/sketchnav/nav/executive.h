@@ -44,7 +44,8 @@ struct ExecutiveParams : DriveParams,
                          LookParams,
                          SideLookParams,
                          FinalLookParams,
-                         RecoverParams {
+                         RecoverParams,
+                         DockParams {
   double tick_s = 0.05;              // [s] control period
   double camera_period_s = 0.1;      // [s] expected frame period (frames are grabbed at this pace)
   double max_time_s = 900;           // [s] whole run
@@ -55,7 +56,6 @@ struct ExecutiveParams : DriveParams,
                                      // obstacle at or before it, ends the section
   double perception_period_s = 0.2;  // [s] frames given to perception at most this often
   double goal_stop_s = 0.5;          // [s] settle time at the goal
-  double dock_m = 1.5;  // [m] this close to the goal, with a free line to it, drive straight there
   double goal_settle_m = 1.0;  // [m] within this of the goal, not 5 cm closer for
   double goal_settle_s = 8;    // [s] this long: arrived as close as it can get
   // Where the sketch puts the attended landmarks goes to perception (a foveal look there) on
@@ -86,6 +86,7 @@ struct ExecutiveParams : DriveParams,
     SideLookParams::bind(b);
     FinalLookParams::bind(b);
     RecoverParams::bind(b);
+    DockParams::bind(b);
     b("tick_s", tick_s);
     b("camera_period_s", camera_period_s);
     b("max_time_s", max_time_s);
@@ -95,7 +96,6 @@ struct ExecutiveParams : DriveParams,
     b("end_blocked_m", end_blocked_m);
     b("perception_period_s", perception_period_s);
     b("goal_stop_s", goal_stop_s);
-    b("dock_m", dock_m);
     b("goal_settle_m", goal_settle_m);
     b("goal_settle_s", goal_settle_s);
     b("fovea_hints", fovea_hints);
