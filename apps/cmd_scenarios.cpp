@@ -184,7 +184,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   const double max_time = args.getDouble("max-time");
   if (!(max_time > 0)) throw InputError("--max-time must be positive");
   const auto families = regression ? std::vector<std::string>{"corridor", "hall", "office", "mixed"}
-                                    : args.getList("families");
+                                   : args.getList("families");
   for (const auto& f : families)
     if (std::find(scenarioFamilies().begin(), scenarioFamilies().end(), f) ==
         scenarioFamilies().end())

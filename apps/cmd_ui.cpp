@@ -390,17 +390,18 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
   ui::addEditorRoutes(server, eo);
   ui::addRunRoutes(server, runs);
   // The editor's background: a world offered on the run page, as the robot starts in it.
-  server.get(R"(/api/worlds/([^/]+)/map)", [worlds = ro.worlds](const httplib::Request& req,
-                                                               httplib::Response& res) {
-    const std::string name = req.matches[1];
-    if (std::find(worlds.begin(), worlds.end(), name) == worlds.end())
-      return ui::sendError(res, 404, "world map: 'world' '" + name.substr(0, 60) +
-                                         "' is not one of the worlds offered");
-    Json g = worldGeometry(name);
-    const sim::World w = sim::loadWorldByName(name);
-    g["start_world"] = {{"x", w.start.x}, {"y", w.start.y}, {"theta", w.start.theta}};
-    ui::sendJson(res, g);
-  });
+  server.get(R"(/api/worlds/([^/]+)/map)",
+             [worlds = ro.worlds](const httplib::Request& req, httplib::Response& res) {
+               const std::string name = req.matches[1];
+               if (std::find(worlds.begin(), worlds.end(), name) == worlds.end())
+                 return ui::sendError(res, 404,
+                                      "world map: 'world' '" + name.substr(0, 60) +
+                                          "' is not one of the worlds offered");
+               Json g = worldGeometry(name);
+               const sim::World w = sim::loadWorldByName(name);
+               g["start_world"] = {{"x", w.start.x}, {"y", w.start.y}, {"theta", w.start.theta}};
+               ui::sendJson(res, g);
+             });
   server.bind();
   if (so.host != "127.0.0.1" && so.host != "localhost" && so.host != "::1")
     log::warn("ui", "listening beyond this machine: anyone who can reach it can drive the robot",
@@ -416,8 +417,7 @@ int runUi(const std::vector<std::string>& argv, GlobalOptions& g) {
               << "run.html; sketches in " << fs::absolute(eo.sketch_dir).string()
               << ", captures to " << fs::absolute(ro.capture_dir).string()
               << (ro.captures_train ? " (the landmark set)" : "") << ", runs recorded in "
-              << fs::absolute(ro.runs_dir).string() << " (Ctrl+C to stop)"
-              << std::endl;
+              << fs::absolute(ro.runs_dir).string() << " (Ctrl+C to stop)" << std::endl;
   std::signal(SIGINT, onSignal);
   std::signal(SIGTERM, onSignal);
   std::atomic<bool> served{false};

@@ -8,9 +8,9 @@
 #include <opencv2/imgproc.hpp>
 
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
-#include <array>
 #include <filesystem>
 #include <fstream>
 #include <map>
@@ -63,9 +63,9 @@ struct RunController::Live {
   Json map_geometry;
   Json placement;  // the route as the executive places it now (RunHooks::on_placement)
   // run record and progress
-  std::string run_dir;  // this run's folder ("" = none)
-  std::vector<std::array<double, 8>> ticks;  // t v w servo_error(NaN) x y theta section
-  std::vector<std::array<double, 3>> obs;    // t inliers(best) perception_ms
+  std::string run_dir;                            // this run's folder ("" = none)
+  std::vector<std::array<double, 8>> ticks;       // t v w servo_error(NaN) x y theta section
+  std::vector<std::array<double, 3>> obs;         // t inliers(best) perception_ms
   std::vector<std::pair<double, double>> guides;  // the route's guide points (odometry frame)
   double along_m = 0;                             // progress along them [m]
   double first_tick_wall = 0, first_tick_t = 0;   // for the real-time factor
@@ -305,7 +305,8 @@ std::string RunController::newRunDir(const RunRequest& request) const {
   const std::string name = stamp + "-" + what;
   fs::path dir = fs::path(opt_.runs_dir) / name;
   // Two runs in the same second get distinct folders rather than mixing outputs.
-  for (int i = 2; fs::exists(dir); ++i) dir = fs::path(opt_.runs_dir) / (name + "-" + std::to_string(i));
+  for (int i = 2; fs::exists(dir); ++i)
+    dir = fs::path(opt_.runs_dir) / (name + "-" + std::to_string(i));
   std::error_code ec;
   fs::create_directories(dir, ec);
   if (ec) throw RuntimeError("runs folder: cannot create " + dir.string() + ": " + ec.message());
@@ -332,14 +333,17 @@ void RunController::start(const RunRequest& request) {
       // Refused (the caller gets a 400 naming the file), and recorded like any run from the
       // page: its folder with a summary saying why, and the state the page's card shows.
       std::string run_dir;
-      Json summary = {{"success", false}, {"error", true}, {"refused", true}, {"reason", why},
+      Json summary = {{"success", false},
+                      {"error", true},
+                      {"refused", true},
+                      {"reason", why},
                       {"request", request.toJson()}};
       try {
         if (!opt_.runs_dir.empty()) run_dir = newRunDir(request);
         if (!run_dir.empty()) {
           summary["out_dir"] = run_dir;
-          writeFileAtomically((fs::path(run_dir) / "summary.json").string(),
-                              summary.dump(2) + "\n", "run summary");
+          writeFileAtomically((fs::path(run_dir) / "summary.json").string(), summary.dump(2) + "\n",
+                              "run summary");
         }
       } catch (const std::exception& w) {
         log::error("ui", "cannot write the refused run's record", {{"error", w.what()}});
@@ -507,11 +511,14 @@ void RunController::runThread(RunRequest request) {
     log::error("ui", "run failed", {{"error", reason}});
     // The record of the run says why there is nothing else in its folder.
     if (!h.out_dir.empty() && !fs::exists(fs::path(h.out_dir) / "summary.json")) {
-      summary = {{"success", false}, {"error", true}, {"reason", reason},
-                 {"request", request.toJson()}, {"out_dir", h.out_dir}};
+      summary = {{"success", false},
+                 {"error", true},
+                 {"reason", reason},
+                 {"request", request.toJson()},
+                 {"out_dir", h.out_dir}};
       try {
-        writeFileAtomically((fs::path(h.out_dir) / "summary.json").string(),
-                            summary.dump(2) + "\n", "run summary");
+        writeFileAtomically((fs::path(h.out_dir) / "summary.json").string(), summary.dump(2) + "\n",
+                            "run summary");
       } catch (const std::exception& w) {
         log::error("ui", "cannot write the run's summary", {{"error", w.what()}});
       }
@@ -850,30 +857,33 @@ void addRunRoutes(Server& server, RunController& rc) {
     res.set_content(std::string(jpg.begin(), jpg.end()), "image/jpeg");
   });
   server.get("/api/run/series", [&rc](const httplib::Request& req, httplib::Response& res) {
-    sendJson(res, rc.series(queryInt(req, "tick", 0, 0, 1 << 30), queryInt(req, "obs", 0, 0, 1 << 30)));
+    sendJson(res,
+             rc.series(queryInt(req, "tick", 0, 0, 1 << 30), queryInt(req, "obs", 0, 0, 1 << 30)));
   });
   server.get("/api/runs", [&rc](const httplib::Request&, httplib::Response& res) {
     sendJson(res, {{"runs_dir", rc.options().runs_dir}, {"runs", listRuns(rc.options().runs_dir)}});
   });
-  server.get(R"(/api/runs/([^/]+)/([^/]+))", [&rc](const httplib::Request& req,
-                                                   httplib::Response& res) {
-    const std::string id = req.matches[1], file = req.matches[2];
-    static const std::map<std::string, std::string> kinds = {
-        {"summary.json", "application/json"},
-        {"trajectory.png", "image/png"},
-        {"telemetry.csv", "text/plain; charset=utf-8"},
-        {"events.jsonl", "text/plain; charset=utf-8"}};
-    const auto kind = kinds.find(file);
-    if (kind == kinds.end())
-      throw InputError("run file: 'file' must be summary.json, trajectory.png, telemetry.csv or "
-                       "events.jsonl (not '" + file.substr(0, 60) + "')");
-    const fs::path p = runFolder(rc.options().runs_dir, id) / file;
-    std::ifstream in(p, std::ios::binary);
-    if (!in) return sendError(res, 404, "run '" + id + "' has no " + file + " (yet)");
-    std::ostringstream ss;
-    ss << in.rdbuf();
-    res.set_content(ss.str(), kind->second);
-  });
+  server.get(R"(/api/runs/([^/]+)/([^/]+))",
+             [&rc](const httplib::Request& req, httplib::Response& res) {
+               const std::string id = req.matches[1], file = req.matches[2];
+               static const std::map<std::string, std::string> kinds = {
+                   {"summary.json", "application/json"},
+                   {"trajectory.png", "image/png"},
+                   {"telemetry.csv", "text/plain; charset=utf-8"},
+                   {"events.jsonl", "text/plain; charset=utf-8"}};
+               const auto kind = kinds.find(file);
+               if (kind == kinds.end())
+                 throw InputError(
+                     "run file: 'file' must be summary.json, trajectory.png, telemetry.csv or "
+                     "events.jsonl (not '" +
+                     file.substr(0, 60) + "')");
+               const fs::path p = runFolder(rc.options().runs_dir, id) / file;
+               std::ifstream in(p, std::ios::binary);
+               if (!in) return sendError(res, 404, "run '" + id + "' has no " + file + " (yet)");
+               std::ostringstream ss;
+               ss << in.rdbuf();
+               res.set_content(ss.str(), kind->second);
+             });
   server.get("/api/run/worlds", [&rc](const httplib::Request&, httplib::Response& res) {
     const auto& o = rc.options();
     // Listed on every request: a sketch saved in the editor appears without a restart.

@@ -36,7 +36,9 @@ void SideLookParams::validate() const {
           "nav.side_look_max_bearing_deg", "must be in (0, 180]");
 }
 
-void DockParams::validate() const { require(dock_m >= 0, "nav.dock_m", "must be >= 0"); }
+void DockParams::validate() const {
+  require(dock_m >= 0, "nav.dock_m", "must be >= 0");
+}
 
 std::optional<Docking::Proposal> Docking::propose(
     const Polar& goal, double free_m, const std::function<std::optional<WayRound>()>& plan,

@@ -618,8 +618,7 @@ struct Executive::Impl {
           if (!std::isfinite(b)) return std::nullopt;
           const double from_start =
               (detour.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm();
-          return Docking::WayRound{b, detour.length_m,
-                                   std::max(0.0, detour.length_m - from_start)};
+          return Docking::WayRound{b, detour.length_m, std::max(0.0, detour.length_m - from_start)};
         };
       if (const auto d = docker.propose(pg, free, plan, s.exec)) {
         docking = true;

@@ -252,7 +252,7 @@ TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
 // Docking: a free line to the goal is driven straight, slowing in the last 0.6 m; a blocked
 // line takes a short way round when one is planned, and nothing when the way is long or none.
 TEST(Docking, DrivesAFreeLineOrAShortWayRoundToTheGoal) {
-  const DriveParams drive;  // 0.3 m/s
+  const DriveParams drive;           // 0.3 m/s
   const Docking dock(DockParams{});  // dock_m 1.5
   const auto at = [](double range, double bearing) {
     Polar g;
@@ -292,8 +292,8 @@ TEST(Docking, DrivesAFreeLineOrAShortWayRoundToTheGoal) {
   // A long way round (over dock_m + 1.5 m): the goal estimate is behind a wall.
   EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, way(-0.3, 3.1, 3.0), drive));
   // No way found, or no planning: no docking.
-  EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, [] { return std::optional<Docking::WayRound>(); },
-                            drive));
+  EXPECT_FALSE(dock.propose(
+      at(1.2, 0.0), 0.5, [] { return std::optional<Docking::WayRound>(); }, drive));
   EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, nullptr, drive));
 }
 

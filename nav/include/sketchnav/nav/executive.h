@@ -56,8 +56,8 @@ struct ExecutiveParams : DriveParams,
                                      // obstacle at or before it, ends the section
   double perception_period_s = 0.2;  // [s] frames given to perception at most this often
   double goal_stop_s = 0.5;          // [s] settle time at the goal
-  double goal_settle_m = 1.0;  // [m] within this of the goal, not 5 cm closer for
-  double goal_settle_s = 8;    // [s] this long: arrived as close as it can get
+  double goal_settle_m = 1.0;        // [m] within this of the goal, not 5 cm closer for
+  double goal_settle_s = 8;          // [s] this long: arrived as close as it can get
   // Where the sketch puts the attended landmarks goes to perception (a foveal look there) on
   // every frame, not only in the final look (final_look_fovea): landmarks are then recognised about
   // twice as far away (3 -> 5 m), and with far sightings kept as bearings (fit_bearing_only) their
