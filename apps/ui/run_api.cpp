@@ -37,6 +37,24 @@ Json statsJson(const hw::DeviceStats& s) {
           {"incomplete", s.incomplete},
           {"last_error", s.last_error}};
 }
+// The summary of a run page run that has nothing else to say (it was refused, or its runner
+// threw before writing one): why, and what was asked; written to <out_dir>/summary.json when
+// out_dir is not "" (a failure to write is logged: the state still says why).
+Json errorRecord(const std::string& out_dir, const RunRequest& request, const std::string& reason,
+                 bool refused) {
+  Json summary = {
+      {"success", false}, {"error", true}, {"reason", reason}, {"request", request.toJson()}};
+  if (refused) summary["refused"] = true;
+  if (out_dir.empty()) return summary;
+  summary["out_dir"] = out_dir;
+  try {
+    writeFileAtomically((fs::path(out_dir) / "summary.json").string(), summary.dump(2) + "\n",
+                        "run summary");
+  } catch (const std::exception& w) {
+    log::error("ui", "cannot write the run's summary", {{"error", w.what()}});
+  }
+  return summary;
+}
 }  // namespace
 
 // ---- live state ----------------------------------------------------------------------------
@@ -333,21 +351,12 @@ void RunController::start(const RunRequest& request) {
       // Refused (the caller gets a 400 naming the file), and recorded like any run from the
       // page: its folder with a summary saying why, and the state the page's card shows.
       std::string run_dir;
-      Json summary = {{"success", false},
-                      {"error", true},
-                      {"refused", true},
-                      {"reason", why},
-                      {"request", request.toJson()}};
       try {
         if (!opt_.runs_dir.empty()) run_dir = newRunDir(request);
-        if (!run_dir.empty()) {
-          summary["out_dir"] = run_dir;
-          writeFileAtomically((fs::path(run_dir) / "summary.json").string(), summary.dump(2) + "\n",
-                              "run summary");
-        }
       } catch (const std::exception& w) {
-        log::error("ui", "cannot write the refused run's record", {{"error", w.what()}});
+        log::error("ui", "cannot create the refused run's folder", {{"error", w.what()}});
       }
+      const Json summary = errorRecord(run_dir, request, why, true);
       {
         std::lock_guard<std::mutex> ll(live_->m);
         live_->reset();
@@ -510,19 +519,8 @@ void RunController::runThread(RunRequest request) {
     reason = e.what();
     log::error("ui", "run failed", {{"error", reason}});
     // The record of the run says why there is nothing else in its folder.
-    if (!h.out_dir.empty() && !fs::exists(fs::path(h.out_dir) / "summary.json")) {
-      summary = {{"success", false},
-                 {"error", true},
-                 {"reason", reason},
-                 {"request", request.toJson()},
-                 {"out_dir", h.out_dir}};
-      try {
-        writeFileAtomically((fs::path(h.out_dir) / "summary.json").string(), summary.dump(2) + "\n",
-                            "run summary");
-      } catch (const std::exception& w) {
-        log::error("ui", "cannot write the run's summary", {{"error", w.what()}});
-      }
-    }
+    if (!h.out_dir.empty() && !fs::exists(fs::path(h.out_dir) / "summary.json"))
+      summary = errorRecord(h.out_dir, request, reason, false);
   }
   std::lock_guard<std::mutex> l(live->m);
   live->summary = summary;
