@@ -3,6 +3,7 @@
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
 #include <opencv2/videoio.hpp>
+#include <opencv2/videoio/registry.hpp>
 
 #include <algorithm>
 #include <cctype>
@@ -129,6 +130,18 @@ struct VideoCamera::Impl {
   cv::VideoCapture cap;
 };
 
+namespace {
+// A file through the backends that read files, in OpenCV's order, except gPhoto2: with
+// CAP_ANY, a file FFmpeg cannot read goes on to gPhoto2, which looks for still cameras on the
+// USB bus (seconds on a busy bus, and libgphoto2 leaks libusb's device list each time:
+// LeakSanitizer, doc/reliability.md). A video file is never a USB still camera.
+bool openFile(cv::VideoCapture& cap, const std::string& path) {
+  for (const auto api : cv::videoio_registry::getStreamBackends())
+    if (api != cv::CAP_GPHOTO2 && cap.open(path, api)) return true;
+  return false;
+}
+}  // namespace
+
 VideoCamera::VideoCamera(const std::string& source, double hfov_deg, std::string uri)
     : impl_(std::make_unique<Impl>()), uri_(uri.empty() ? "video://" + source : uri) {
   is_device_ = !source.empty() && std::all_of(source.begin(), source.end(),
@@ -138,7 +151,7 @@ VideoCamera::VideoCamera(const std::string& source, double hfov_deg, std::string
       throw InputError("video device " + source + " cannot be opened");
   } else {
     if (!fs::exists(source)) throw InputError("video file '" + source + "' does not exist");
-    if (!impl_->cap.open(source)) throw InputError("video file '" + source + "' cannot be opened");
+    if (!openFile(impl_->cap, source)) throw InputError("video file '" + source + "' cannot be opened");
   }
   int w = static_cast<int>(impl_->cap.get(cv::CAP_PROP_FRAME_WIDTH));
   int h = static_cast<int>(impl_->cap.get(cv::CAP_PROP_FRAME_HEIGHT));
