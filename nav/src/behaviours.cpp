@@ -34,6 +34,10 @@ void SideLookParams::validate() const {
           "must be in [0, 90)");
   require(side_look_max_bearing_deg > 0 && side_look_max_bearing_deg <= 180,
           "nav.side_look_max_bearing_deg", "must be in (0, 180]");
+  require(side_look_max_looks >= 1, "nav.side_look_max_looks", "must be >= 1");
+  require(side_look_rebearing_deg > 0 && side_look_rebearing_deg <= 180,
+          "nav.side_look_rebearing_deg", "must be in (0, 180]");
+  require(side_look_walker_m >= 0, "nav.side_look_walker_m", "must be >= 0 m (0 = off)");
 }
 
 void DockParams::validate() const {
@@ -105,7 +109,7 @@ FollowBehaviour::Proposal FollowBehaviour::propose(double lookahead_bearing,
 
 SideLook::Outcome SideLook::update(const LandmarkTracker& landmarks, const AttendedLandmark* a,
                                    double now, bool can_look, bool busy, bool final_looking,
-                                   bool give_way) {
+                                   bool give_way, double heading) {
   Outcome out;
   const double max_b = p_.side_look_max_bearing_deg * M_PI / 180;
   if (active_) {
@@ -116,18 +120,24 @@ SideLook::Outcome SideLook::update(const LandmarkTracker& landmarks, const Atten
       active_ = false;
       out.ended = event::SideLookEnd{landmarks.landmark(k_, i_).id, seen, now - t0_};
     }
-  } else if (a && can_look && p_.side_look_s > 0 && !busy && !final_looking &&
-             !looked_.count({a->k, a->i})) {
+  } else if (a && can_look && p_.side_look_s > 0 && !busy && !final_looking) {
     const auto& t = landmarks.track(a->k, a->i);
     const double b = std::abs(a->pred.bearing);
-    if (t.state == LandmarkState::Pending && t.frames_seen == 0 &&
+    const double sight = heading + a->pred.bearing;
+    const auto it = looked_.find({a->k, a->i});
+    const bool may = it == looked_.end() || (it->second.looks < p_.side_look_max_looks &&
+                                             std::abs(wrapAngle(sight - it->second.sight)) >=
+                                                 p_.side_look_rebearing_deg * M_PI / 180);
+    if (may && t.state == LandmarkState::Pending && t.frames_seen == 0 &&
         b > half_fov_ - p_.side_look_margin_deg * M_PI / 180 && b <= max_b &&
         a->pred.range <= p_.side_look_range_m && a->pred.range >= p_.side_look_min_range_m) {
       active_ = true;
       k_ = a->k;
       i_ = a->i;
       t0_ = now;
-      looked_.insert({a->k, a->i});
+      auto& l = looked_[{a->k, a->i}];
+      ++l.looks;
+      l.sight = sight;
       out.started = event::SideLookStart{landmarks.landmark(a->k, a->i).id, a->k,
                                          a->pred.bearing * 180 / M_PI, a->pred.range};
     }

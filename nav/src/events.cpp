@@ -194,6 +194,11 @@ struct Writer {
     j["to_end_m"] = e.to_end_m;
     return "end_blocked";
   }
+  const char* operator()(const event::SectionSettled& e) {
+    j["section"] = e.section;
+    j["to_end_m"] = e.to_end_m;
+    return "section_settled";
+  }
   const char* operator()(const event::YieldStart& e) {
     j["in_lane"] = e.in_lane;
     j["clearance_m"] = e.clearance_m;

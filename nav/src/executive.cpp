@@ -39,6 +39,9 @@ void ExecutiveParams::validate() const {
   require(replan_s > 0, "nav.replan_s", "must be > 0");
   require(goal_settle_m >= 0, "nav.goal_settle_m", "must be >= 0");
   require(goal_settle_s > 0, "nav.goal_settle_s", "must be > 0");
+  require(section_settle_frac >= 0 && section_settle_frac <= 1, "nav.section_settle_frac",
+          "must be in [0, 1]");
+  require(section_settle_s > 0, "nav.section_settle_s", "must be > 0 s");
 }
 
 NavSettings navSettingsFrom(const Config& c) {
@@ -201,7 +204,8 @@ struct Executive::Impl {
   SideLook side_look;          // (its camera's field of view is known once the camera is)
   int detours = 0;
   SettleChecker settle_checker;
-  RouteAnchor anchor;  // the fixes and the refit / realign policy
+  SectionSettleChecker section_settle;  // an intermediate end the robot cannot get near
+  RouteAnchor anchor;                   // the fixes and the refit / realign policy
   // Goal doorway (route goal_place): stopping points of the doorways seen near the goal
   // (odometry frame, newest last); the goal put on one is tracker.goalOdom().
   std::vector<Eigen::Vector2d> door_stops;
@@ -229,6 +233,8 @@ struct Executive::Impl {
         final_look(st.exec, st.exec.k_heading),
         side_look(st.exec, 0.0, st.exec.k_heading, st.exec.max_w),
         settle_checker(st.exec.goal_settle_m, st.exec.goal_settle_s),
+        section_settle(st.exec.section_settle_frac, st.exec.end_blocked_m,
+                       st.exec.section_settle_s),
         anchor(st.exec) {
     s.exec.validate();
     s.select.validate();
@@ -734,10 +740,17 @@ struct Executive::Impl {
     } else {
       endDetour("no range data");
     }
-    // Looking to the side for a landmark predicted out of view (SideLook).
+    // Looking to the side for a landmark predicted out of view (SideLook). A look stands the
+    // robot still: none starts, and one under way gives way, near a walking person
+    // (side_look_walker_m) or in their lane.
+    bool walker_near = in_lane || yielding;
+    for (const auto& m : movers.walkers())
+      walker_near |=
+          (m.position - Eigen::Vector2d(pose.x, pose.y)).norm() <= s.exec.side_look_walker_m;
     const auto sl =
         side_look.update(landmarks, att.empty() ? nullptr : &att[0], now, dev.camera != nullptr,
-                         docking || recovery.active(), final_looking, dodging && moving_seen);
+                         docking || recovery.active() || walker_near, final_looking,
+                         (dodging && moving_seen) || walker_near, pose.theta);
     if (sl.ended) {
       event(*sl.ended);
       progress_checker.reset(pose, now);  // standing still to look is not being stuck
@@ -777,6 +790,18 @@ struct Executive::Impl {
       succeed("reached the end of the route (could not get closer than " +
               std::to_string(prog.to_end_m).substr(0, 4) + " m)");
       return;
+    }
+    // An intermediate end the robot cannot get near, blocked or not in view (the corner drawn
+    // beyond the corridor's wall): the section is done where the robot came closest.
+    const bool section_settled =
+        section_settle.update(sec.length_m, prog.to_end_m, now,
+                              servoing || sl.command.has_value() || yielding) &&
+        k + 1 < tracker.count() && !end_blocked;
+    if (section_settled) {
+      event(event::SectionSettled{k, prog.to_end_m});
+      tracker.advance();
+      closeSections(k);
+      if (status != RunStatus::Running) return;
     }
     if (end_blocked) {
       sectionBlocked_ = true;
@@ -983,6 +1008,7 @@ struct Executive::Impl {
                            " done");
     }
     section_t0 = now;
+    section_settle.restart(now);
     sectionBlocked_ = false;
   }
 };
@@ -999,6 +1025,7 @@ void Executive::start() {
   I.t0 = I.now = I.dev.clock->now();
   I.next_tick = I.t0;
   I.section_t0 = I.t0;
+  I.section_settle.restart(I.t0);
   I.progress_checker.reset(hw::Pose2D{}, I.t0);
   I.anchor.start(I.tracker);
   I.safety.start(I.t0);

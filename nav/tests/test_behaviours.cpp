@@ -69,13 +69,13 @@ TEST(SideLook, TurnsTowardsALandmarkOutOfViewUntilItIsSeen) {
   SideLook look(p, 30 * kDeg, 1.2, 0.8);
   const AttendedLandmark a{0, 0, {45 * kDeg, 2.8}, true};
   // Busy (docking, recovering), no camera, or the final look running: no look starts.
-  EXPECT_FALSE(look.update(lt, &a, 1.0, true, true, false, false).started);
-  EXPECT_FALSE(look.update(lt, &a, 1.0, false, false, false, false).started);
-  EXPECT_FALSE(look.update(lt, &a, 1.0, true, false, true, false).started);
+  EXPECT_FALSE(look.update(lt, &a, 1.0, true, true, false, false, 0.0).started);
+  EXPECT_FALSE(look.update(lt, &a, 1.0, false, false, false, false, 0.0).started);
+  EXPECT_FALSE(look.update(lt, &a, 1.0, true, false, true, false, 0.0).started);
   // In view (20 deg < 30 - 5): no need.
   const AttendedLandmark in_view{0, 0, {20 * kDeg, 2.8}, true};
-  EXPECT_FALSE(look.update(lt, &in_view, 1.0, true, false, false, false).started);
-  auto o = look.update(lt, &a, 1.0, true, false, false, false);
+  EXPECT_FALSE(look.update(lt, &in_view, 1.0, true, false, false, false, 0.0).started);
+  auto o = look.update(lt, &a, 1.0, true, false, false, false, 0.0);
   ASSERT_TRUE(o.started.has_value());
   EXPECT_EQ(o.started->id, "A");
   EXPECT_NEAR(o.started->bearing_deg, 45, 1e-9);
@@ -84,12 +84,12 @@ TEST(SideLook, TurnsTowardsALandmarkOutOfViewUntilItIsSeen) {
   EXPECT_DOUBLE_EQ(o.command->w, 0.8);  // 1.2 x 0.785 clamped
   EXPECT_TRUE(look.active());
   // Dodging someone coming towards the robot: the dodge drives, the look goes on.
-  o = look.update(lt, &a, 1.5, true, false, false, true);
+  o = look.update(lt, &a, 1.5, true, false, false, true, 0.0);
   EXPECT_FALSE(o.command.has_value());
   EXPECT_FALSE(o.ended.has_value());
   // Recognised: over.
   lt.track(0, 0).frames_seen = 1;
-  o = look.update(lt, &a, 2.0, true, false, false, false);
+  o = look.update(lt, &a, 2.0, true, false, false, false, 0.0);
   ASSERT_TRUE(o.ended.has_value());
   EXPECT_TRUE(o.ended->seen);
   EXPECT_NEAR(o.ended->duration_s, 1.0, 1e-12);
@@ -104,26 +104,62 @@ TEST(SideLook, OncePerLandmarkWithinItsBudget) {
   p.side_look_s = 2.0;
   SideLook look(p, 30 * kDeg, 1.2, 0.8);
   const AttendedLandmark a{0, 0, {60 * kDeg, 2.0}, true};
-  ASSERT_TRUE(look.update(lt, &a, 10.0, true, false, false, false).started);
-  EXPECT_FALSE(look.update(lt, &a, 12.0, true, false, false, false).ended) << "2 s: not over";
-  const auto o = look.update(lt, &a, 12.1, true, false, false, false);
+  ASSERT_TRUE(look.update(lt, &a, 10.0, true, false, false, false, 0.0).started);
+  EXPECT_FALSE(look.update(lt, &a, 12.0, true, false, false, false, 0.0).ended) << "2 s: not over";
+  const auto o = look.update(lt, &a, 12.1, true, false, false, false, 0.0);
   ASSERT_TRUE(o.ended.has_value());
   EXPECT_FALSE(o.ended->seen);
   // Never again for A.
-  EXPECT_FALSE(look.update(lt, &a, 13.0, true, false, false, false).started);
+  EXPECT_FALSE(look.update(lt, &a, 13.0, true, false, false, false, 0.0).started);
   // Beyond the angle budget (110 deg), too close or too far: none for B either.
   for (const Polar q : {Polar{120 * kDeg, 2.0}, Polar{60 * kDeg, 0.4}, Polar{60 * kDeg, 4.5}}) {
     const AttendedLandmark b{0, 1, q, true};
-    EXPECT_FALSE(look.update(lt, &b, 14.0, true, false, false, false).started);
+    EXPECT_FALSE(look.update(lt, &b, 14.0, true, false, false, false, 0.0).started);
   }
   // Another landmark attended while looking ends the look.
   SideLook look2(p, 30 * kDeg, 1.2, 0.8);
   const AttendedLandmark b{0, 1, {-50 * kDeg, 3.0}, true};
-  ASSERT_TRUE(look2.update(lt, &b, 20.0, true, false, false, false).started);
-  const auto moved_on = look2.update(lt, &a, 20.5, true, false, false, false);
+  ASSERT_TRUE(look2.update(lt, &b, 20.0, true, false, false, false, 0.0).started);
+  const auto moved_on = look2.update(lt, &a, 20.5, true, false, false, false, 0.0);
   ASSERT_TRUE(moved_on.ended.has_value());
   EXPECT_EQ(moved_on.ended->id, "B");
   EXPECT_FALSE(moved_on.started.has_value()) << "one thing per tick: A's look waits";
+}
+
+TEST(SideLook, FurtherLooksOnlyFromANewViewpoint) {
+  const auto route = sideRoute();
+  LandmarkTracker lt(route, {});
+  SideLookParams p;
+  p.side_look_s = 2.0;
+  p.side_look_max_looks = 3;
+  p.side_look_rebearing_deg = 25;
+  SideLook look(p, 30 * kDeg, 1.2, 0.8);
+  // Driving along x past A (heading 0): first look at 35 deg, unseen after its 2 s.
+  const AttendedLandmark a35{0, 0, {35 * kDeg, 3.0}, true};
+  ASSERT_TRUE(look.update(lt, &a35, 10.0, true, false, false, false, 0.0).started);
+  ASSERT_TRUE(look.update(lt, &a35, 12.1, true, false, false, false, 0.0).ended);
+  // Turned on the spot by 30 deg (a dodge): the line of sight has not moved, no new look.
+  const AttendedLandmark turned{0, 0, {65 * kDeg, 3.0}, true};
+  EXPECT_FALSE(look.update(lt, &turned, 13.0, true, false, false, false, -30 * kDeg).started);
+  // Driven on: the line of sight at 50 deg (15 deg on) is not yet a new viewpoint; at 62 it is.
+  const AttendedLandmark a50{0, 0, {50 * kDeg, 2.5}, true}, a62{0, 0, {62 * kDeg, 2.2}, true};
+  EXPECT_FALSE(look.update(lt, &a50, 14.0, true, false, false, false, 0.0).started);
+  auto o = look.update(lt, &a62, 15.0, true, false, false, false, 0.0);
+  ASSERT_TRUE(o.started.has_value());
+  EXPECT_NEAR(o.started->bearing_deg, 62, 1e-9);
+  ASSERT_TRUE(look.update(lt, &a62, 17.1, true, false, false, false, 0.0).ended);
+  // The third and last at 90 deg (abreast), then never again.
+  const AttendedLandmark a90{0, 0, {90 * kDeg, 2.0}, true}, a105{0, 0, {105 * kDeg, 2.1}, true};
+  ASSERT_TRUE(look.update(lt, &a90, 20.0, true, false, false, false, 0.0).started);
+  ASSERT_TRUE(look.update(lt, &a90, 22.1, true, false, false, false, 0.0).ended);
+  const AttendedLandmark behind{0, 0, {-150 * kDeg, 2.5}, true};  // beyond 110 anyway
+  EXPECT_FALSE(look.update(lt, &a105, 30.0, true, false, false, false, 40 * kDeg).started);
+  EXPECT_FALSE(look.update(lt, &behind, 31.0, true, false, false, false, 0.0).started);
+  // With the default of one look, the second viewpoint gets none.
+  SideLook once(SideLookParams{}, 30 * kDeg, 1.2, 0.8);
+  ASSERT_TRUE(once.update(lt, &a35, 10.0, true, false, false, false, 0.0).started);
+  ASSERT_TRUE(once.update(lt, &a35, 14.1, true, false, false, false, 0.0).ended);
+  EXPECT_FALSE(once.update(lt, &a90, 20.0, true, false, false, false, 0.0).started);
 }
 
 // The goal at (10, 0); C 2 m before it on the left, D behind the start.
@@ -315,6 +351,12 @@ TEST(BehaviourParams, ValidateNamesTheSetting) {
   names(
       SideLookParams{}, [](SideLookParams& p) { p.side_look_min_range_m = 5; },
       "nav.side_look_min_range_m");
+  names(
+      SideLookParams{}, [](SideLookParams& p) { p.side_look_max_looks = 0; },
+      "nav.side_look_max_looks");
+  names(
+      SideLookParams{}, [](SideLookParams& p) { p.side_look_rebearing_deg = 0; },
+      "nav.side_look_rebearing_deg");
   names(
       FinalLookParams{}, [](FinalLookParams& p) { p.final_look_s = 0; }, "nav.final_look_s");
   names(

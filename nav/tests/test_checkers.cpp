@@ -55,3 +55,50 @@ TEST(SettleChecker, SettlesWhenNoLongerGettingCloserNearTheGoal) {
   EXPECT_FALSE(look.update(true, 0.5, 44.0, false));
   EXPECT_TRUE(look.update(true, 0.5, 44.5, false));
 }
+
+TEST(SectionSettleChecker, SettlesWhereTheRobotCameClosestToAnEndItCannotReach) {
+  // A 10 m section: near = max(1 m, 0.3 x 10 m) = 3 m; settle after 15 s without 5 cm gained.
+  SectionSettleChecker sc(0.3, 1.0, 15.0);
+  EXPECT_DOUBLE_EQ(sc.nearM(10.0), 3.0);
+  EXPECT_DOUBLE_EQ(sc.nearM(2.0), 1.0);
+  sc.restart(0.0);
+  // Driving towards the end at 0.3 m/s, 5 cm per tick... of 1/6 s: always gaining.
+  double t = 0, d = 10;
+  for (; d > 2.5; d -= 0.05, t += 1.0 / 6) EXPECT_FALSE(sc.update(10, d, t, false));
+  // Against the wall 2.5 m from it; then the avoider drives it 5 m back along the corridor
+  // and it comes back to the same spot: leaving does not restart the clock.
+  const double closest_t = t;
+  for (; t < closest_t + 10; t += 0.5)
+    EXPECT_FALSE(sc.update(10, 2.5 + (t - closest_t) * 0.3, t, false));
+  for (; t < closest_t + 20; t += 0.5) EXPECT_FALSE(sc.update(10, 5.5, t, false));  // far: not here
+  // Driving back towards it at 0.3 m/s: inside 3 m again, but closing in, so not yet.
+  double d2 = 5.5;
+  for (; d2 > 2.6; d2 -= 0.15, t += 0.5) EXPECT_FALSE(sc.update(10, d2, t, false));
+  // Back against the wall 2.6 m from it: settled once it has stopped closing in (3 s).
+  const double back_t = t;
+  bool settled = false;
+  for (; t < back_t + 4 && !settled; t += 0.5) settled = sc.update(10, 2.6, t, false);
+  EXPECT_TRUE(settled);
+  EXPECT_GT(t, back_t + 2.5);
+  // A hold (servoing, a side look, waiting for a person) restarts the clock.
+  SectionSettleChecker held(0.3, 1.0, 15.0);
+  held.restart(0.0);
+  EXPECT_FALSE(held.update(10, 2.0, 1.0, false));
+  EXPECT_FALSE(held.update(10, 2.0, 10.0, true));
+  EXPECT_FALSE(held.update(10, 2.0, 24.0, false));
+  EXPECT_TRUE(held.update(10, 2.0, 25.5, false));
+  // A new section starts afresh; 0 = off.
+  held.restart(30.0);
+  EXPECT_FALSE(held.update(10, 2.0, 31.0, false));
+  EXPECT_FALSE(held.update(10, 2.0, 45.0, false));
+  EXPECT_TRUE(held.update(10, 2.0, 46.5, false));
+  SectionSettleChecker off(0.0, 1.0, 15.0);
+  off.restart(0.0);
+  for (double u = 0; u < 100; u += 1) EXPECT_FALSE(off.update(10, 2.0, u, false));
+  // Within min_near_m (end_blocked_m) of the end it is left to the rules that see the end.
+  SectionSettleChecker in_view(0.3, 1.0, 15.0);
+  in_view.restart(0.0);
+  for (double u = 0; u < 100; u += 1) EXPECT_FALSE(in_view.update(10, 0.8, u, false));
+  // Once that near, the end was reachable: led away from it (a servo), it never settles.
+  for (double u = 100; u < 200; u += 1) EXPECT_FALSE(in_view.update(10, 2.0, u, false));
+}

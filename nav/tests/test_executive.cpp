@@ -179,7 +179,8 @@ void addBarrier(FakeWorld& w) {
 std::vector<std::string> detourEndReasons(const Recorder& r) {
   std::vector<std::string> out;
   for (const auto& e : r.events)
-    if (std::string(e.type()) == "detour_end") out.push_back(e.toJson().value("reason", std::string()));
+    if (std::string(e.type()) == "detour_end")
+      out.push_back(e.toJson().value("reason", std::string()));
   return out;
 }
 }  // namespace
@@ -428,6 +429,48 @@ TEST(Executive, NoSideLookForALandmarkInViewOrBehindTheAngleBudget) {
   narrow.settings.exec.side_look_max_bearing_deg = 60;
   narrow.run();
   EXPECT_EQ(narrow.rec.count("side_look_start"), 0);
+}
+
+namespace {
+// An L-shaped corridor 2 m wide (y in [-1, 1] eastwards to its end wall at x = 10, then north
+// up x in [8, 10] to y = 9) with the sketch's first corner drawn 2 m past the corridor's end
+// (distances drawn too long): the first section's end lies beyond the end wall, where the robot
+// cannot get within 2 m of it, and the line through the end is never crossed inside the
+// corridor. The second section leads to a goal up the north leg.
+void cornerBeyondTheWall(Scenario& s) {
+  s.route = makeRoute({{0, 0}, {12, 0}, {9, 6}});
+  s.world.obstacles.clear();
+  s.world.walls = {{{-1, -1}, {10, -1}}, {{10, -1}, {10, 9}}, {{10, 9}, {8, 9}},
+                   {{8, 9}, {8, 1}},     {{8, 1}, {-1, 1}},   {{-1, 1}, {-1, -1}}};
+  s.settings.exec.max_time_s = 150;
+}
+double lastSectionSettledToEnd(const Recorder& r) {
+  for (const auto& e : r.events)
+    if (std::string(e.type()) == "section_settled") return e.toJson().value("to_end_m", -1.0);
+  return -1;
+}
+}  // namespace
+
+TEST(Executive, ASectionEndDrawnBeyondTheWallEndsWhereTheRobotCameClosest) {
+  Scenario s;
+  cornerBeyondTheWall(s);
+  const auto sum = s.run();
+  ASSERT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
+  EXPECT_EQ(s.rec.count("section_settled"), 1);
+  const double at = lastSectionSettledToEnd(s.rec);
+  EXPECT_GT(at, 1.0);  // farther than end_blocked_m: the rule before it could not end it
+  EXPECT_LT(at, 0.3 * 12);
+  EXPECT_LT(std::hypot(s.world.truth.x - 9.0, s.world.truth.y - 6.0), 0.6);
+  EXPECT_GT(s.rec.min_clearance, 0.05);
+
+  // Without it (section_settle_frac 0) the first section never ends.
+  Scenario off;
+  cornerBeyondTheWall(off);
+  off.settings.exec.section_settle_frac = 0;
+  const auto sum_off = off.run();
+  EXPECT_NE(sum_off.status, RunStatus::Succeeded);
+  EXPECT_EQ(off.rec.count("section_settled"), 0);
+  EXPECT_EQ(off.rec.count("section_done"), 0);
 }
 
 TEST(GoalChecker, ReachedOnlyOnTheLastSectionWithinItsRadiusOrWhenFinished) {

@@ -6,8 +6,8 @@
 // proposes (CommandArbiter decides), the event to report — and never touches the devices, the
 // run's status or the route.
 #include <functional>
+#include <map>
 #include <optional>
-#include <set>
 #include <utility>
 #include <vector>
 
@@ -99,6 +99,17 @@ struct SideLookParams {
   double side_look_min_range_m = 0.5;      // [m] closer than this its bearing means little
   double side_look_margin_deg = 5;         // [deg] inside the half field of view
   double side_look_max_bearing_deg = 110;  // [deg] angle budget: furthest the robot turns
+  // Looks per landmark: a further one (while it is still never seen) only from a new viewpoint,
+  // once the line of sight to it has turned side_look_rebearing_deg [deg] (odometry frame, so
+  // turning on the spot does not count) since the last one started: a poster on a side wall is
+  // seen at a grazing angle from afar and nearly face-on when the robot is abreast of it.
+  int side_look_max_looks = 1;
+  double side_look_rebearing_deg = 25;
+  // A look stands the robot still for up to side_look_s: none starts, and one under way gives
+  // way, while a walking person (MoverTracker::walkers) is within side_look_walker_m [m] or the
+  // robot is in a walker's lane (a person who keeps walking walks into a robot standing there;
+  // at 0.5 m/s one covers 2 m in a look).
+  double side_look_walker_m = 3.0;
   template <class B>
   void bind(B& b) {
     b("side_look_s", side_look_s);
@@ -106,6 +117,9 @@ struct SideLookParams {
     b("side_look_min_range_m", side_look_min_range_m);
     b("side_look_margin_deg", side_look_margin_deg);
     b("side_look_max_bearing_deg", side_look_max_bearing_deg);
+    b("side_look_max_looks", side_look_max_looks);
+    b("side_look_rebearing_deg", side_look_rebearing_deg);
+    b("side_look_walker_m", side_look_walker_m);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };
@@ -128,18 +142,23 @@ class SideLook {
   /// ends when it is seen, is no longer the attended one, the final look runs, the budget is
   /// spent or it is beyond the angle budget. No look starts while `busy` (docking,
   /// recovering); while `give_way` (dodging something that comes towards the robot) the dodge
-  /// drives, the clock still runs.
+  /// drives, the clock still runs. `heading` [rad]: the robot's, odometry frame (the line of
+  /// sight's direction there is heading + the predicted bearing).
   Outcome update(const LandmarkTracker& landmarks, const AttendedLandmark* a, double now,
-                 bool can_look, bool busy, bool final_looking, bool give_way);
+                 bool can_look, bool busy, bool final_looking, bool give_way, double heading);
   bool active() const { return active_; }
 
  private:
   SideLookParams p_;
   double half_fov_, k_heading_, max_w_;
   bool active_ = false;
-  int k_ = -1, i_ = -1;                   // the landmark looked for
-  double t0_ = 0;                         // [s] since when
-  std::set<std::pair<int, int>> looked_;  // once per landmark
+  int k_ = -1, i_ = -1;  // the landmark looked for
+  double t0_ = 0;        // [s] since when
+  struct Looked {
+    int looks = 0;
+    double sight = 0;  // [rad] line of sight (odometry frame) when the last look started
+  };
+  std::map<std::pair<int, int>, Looked> looked_;  // per landmark
 };
 
 /// At the goal, a landmark never seen (too far on the way, or out of view) that the sketch puts

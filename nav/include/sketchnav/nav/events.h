@@ -161,6 +161,11 @@ struct EndBlocked {
   int section = 0;
   double to_end_m = 0;
 };
+/// A section ended where the robot came closest to its end point (SectionSettleChecker).
+struct SectionSettled {
+  int section = 0;
+  double to_end_m = 0;  // [m] when it ended
+};
 struct YieldStart {
   bool in_lane = false;
   double clearance_m = 0;
@@ -203,9 +208,9 @@ using EventData =
                  event::LandmarkLost, event::LandmarkMissed, event::LandmarkPassed,
                  event::SectionDone, event::AvoidStart, event::AvoidEnd, event::WalkerLane,
                  event::DetourStart, event::DetourEnd, event::RecoverStart, event::RecoverEnd,
-                 event::GoalSettled, event::EndBlocked, event::YieldStart, event::YieldEnd,
-                 event::GoalDoor, event::FinalLookStart, event::FinalLookEnd, event::SideLookStart,
-                 event::SideLookEnd>;
+                 event::GoalSettled, event::EndBlocked, event::SectionSettled, event::YieldStart,
+                 event::YieldEnd, event::GoalDoor, event::FinalLookStart, event::FinalLookEnd,
+                 event::SideLookStart, event::SideLookEnd>;
 
 /// One event: when [s, run clock, from start()] and what.
 struct NavEvent {

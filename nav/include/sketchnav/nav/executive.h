@@ -58,6 +58,13 @@ struct ExecutiveParams : DriveParams,
   double goal_stop_s = 0.5;          // [s] settle time at the goal
   double goal_settle_m = 1.0;        // [m] within this of the goal, not 5 cm closer for
   double goal_settle_s = 8;          // [s] this long: arrived as close as it can get
+  // A section's end point the robot cannot get near (drawn beyond a wall; goal_checker.h
+  // SectionSettleChecker): within section_settle_frac x the section's length of it (at least
+  // end_blocked_m), not 5 cm closer than its closest for section_settle_s (servoing, looking
+  // to the side and waiting for a person restart the clock), the section is done. Not the last
+  // section (the goal has goal_settle_*). 0 = off.
+  double section_settle_frac = 0.3;  // fraction of the section's length
+  double section_settle_s = 15;      // [s]
   // Where the sketch puts the attended landmarks goes to perception (a foveal look there) on
   // every frame, not only in the final look (final_look_fovea): landmarks are then recognised about
   // twice as far away (3 -> 5 m), and with far sightings kept as bearings (fit_bearing_only) their
@@ -98,6 +105,8 @@ struct ExecutiveParams : DriveParams,
     b("goal_stop_s", goal_stop_s);
     b("goal_settle_m", goal_settle_m);
     b("goal_settle_s", goal_settle_s);
+    b("section_settle_frac", section_settle_frac);
+    b("section_settle_s", section_settle_s);
     b("fovea_hints", fovea_hints);
     b("detour", detour);
     b("detour_ahead_m", detour_ahead_m);
