@@ -663,12 +663,13 @@ struct Executive::Impl {
     }
     double front = 0;
     bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
+    const std::vector<Mover> walkers = movers.walkers();  // for the avoider and the side look
     if (docking || recovery.active()) {
       endDetour(docking ? "docking" : "recovering");
       if (docking) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
     } else if (!dev.ranges.empty()) {
       avoider.setPose(pose);
-      for (const auto& m : movers.walkers()) avoider.offerWalker(m.position, m.velocity);
+      for (const auto& m : walkers) avoider.offerWalker(m.position, m.velocity);
       const auto av = avoider.step(scans, target_bearing, side, pose.theta, s.exec.v_cruise, now);
       front = av.front_free_m;
       if (av.in_lane && !in_lane) event(event::WalkerLane{av.walker_pos, av.walker_vel, k});
@@ -744,7 +745,7 @@ struct Executive::Impl {
     // robot still: none starts, and one under way gives way, near a walking person
     // (side_look_walker_m) or in their lane.
     bool walker_near = in_lane || yielding;
-    for (const auto& m : movers.walkers())
+    for (const auto& m : walkers)
       walker_near |=
           (m.position - Eigen::Vector2d(pose.x, pose.y)).norm() <= s.exec.side_look_walker_m;
     const auto sl =

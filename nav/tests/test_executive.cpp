@@ -444,9 +444,9 @@ void cornerBeyondTheWall(Scenario& s) {
                    {{8, 9}, {8, 1}},     {{8, 1}, {-1, 1}},   {{-1, 1}, {-1, -1}}};
   s.settings.exec.max_time_s = 150;
 }
-double lastSectionSettledToEnd(const Recorder& r) {
+double firstSectionSettledToEnd(const Recorder& r) {
   for (const auto& e : r.events)
-    if (std::string(e.type()) == "section_settled") return e.toJson().value("to_end_m", -1.0);
+    if (const auto* s = std::get_if<event::SectionSettled>(&e.data)) return s->to_end_m;
   return -1;
 }
 }  // namespace
@@ -457,7 +457,7 @@ TEST(Executive, ASectionEndDrawnBeyondTheWallEndsWhereTheRobotCameClosest) {
   const auto sum = s.run();
   ASSERT_EQ(sum.status, RunStatus::Succeeded) << sum.reason;
   EXPECT_EQ(s.rec.count("section_settled"), 1);
-  const double at = lastSectionSettledToEnd(s.rec);
+  const double at = firstSectionSettledToEnd(s.rec);
   EXPECT_GT(at, 1.0);  // farther than end_blocked_m: the rule before it could not end it
   EXPECT_LT(at, 0.3 * 12);
   EXPECT_LT(std::hypot(s.world.truth.x - 9.0, s.world.truth.y - 6.0), 0.6);

@@ -151,7 +151,8 @@ VideoCamera::VideoCamera(const std::string& source, double hfov_deg, std::string
       throw InputError("video device " + source + " cannot be opened");
   } else {
     if (!fs::exists(source)) throw InputError("video file '" + source + "' does not exist");
-    if (!openFile(impl_->cap, source)) throw InputError("video file '" + source + "' cannot be opened");
+    if (!openFile(impl_->cap, source))
+      throw InputError("video file '" + source + "' cannot be opened");
   }
   int w = static_cast<int>(impl_->cap.get(cv::CAP_PROP_FRAME_WIDTH));
   int h = static_cast<int>(impl_->cap.get(cv::CAP_PROP_FRAME_HEIGHT));

@@ -59,10 +59,11 @@ struct ExecutiveParams : DriveParams,
   double goal_settle_m = 1.0;        // [m] within this of the goal, not 5 cm closer for
   double goal_settle_s = 8;          // [s] this long: arrived as close as it can get
   // A section's end point the robot cannot get near (drawn beyond a wall; goal_checker.h
-  // SectionSettleChecker): within section_settle_frac x the section's length of it (at least
-  // end_blocked_m), not 5 cm closer than its closest for section_settle_s (servoing, looking
-  // to the side and waiting for a person restart the clock), the section is done. Not the last
-  // section (the goal has goal_settle_*). 0 = off.
+  // SectionSettleChecker): within section_settle_frac x the section's length of it but beyond
+  // end_blocked_m (and never within it before), not 5 cm closer than its closest for
+  // section_settle_s (servoing, looking to the side and waiting for a person restart the
+  // clock) and not closing in, the section is done. Not the last section (the goal has
+  // goal_settle_*). 0 = off.
   double section_settle_frac = 0.3;  // fraction of the section's length
   double section_settle_s = 15;      // [s]
   // Where the sketch puts the attended landmarks goes to perception (a foveal look there) on
