@@ -7,7 +7,6 @@
 // into real backgrounds; apps/perception_bench.h, doc/perception-benchmark.md).
 #include <opencv2/imgcodecs.hpp>
 #include <opencv2/imgproc.hpp>
-#include <opencv2/videoio.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -23,7 +22,9 @@
 #include "perception_bench.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
+#include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
+#include "sketchnav/drivers/file_cameras.h"
 #include "sketchnav/drivers/register.h"
 #include "sketchnav/hw/registry.h"
 #include "sketchnav/landmarks/model.h"
@@ -39,63 +40,74 @@ namespace sketchnav::app {
 namespace fs = std::filesystem;
 namespace {
 
-/// Frames from a folder of images (sorted by name), a video file, or a camera URI.
+/// Frames from a folder of images, a video file or a camera URI, through the camera drivers
+/// (drivers::FolderCamera, drivers::VideoCamera, the registry): the same natural order,
+/// unreadable-frame skipping and error texts as a run's camera. Names: the file name of a
+/// folder's image, the frame index of a video, the camera's source otherwise.
 class FrameSource {
  public:
-  FrameSource(const std::string& spec, double hfov_deg, const Config& cfg) {
-    hfov_ = hfov_deg * M_PI / 180.0;
-    if (fs::is_directory(spec)) {
-      for (const auto& e : fs::directory_iterator(spec)) {
-        if (isImageFileName(e.path().string())) files_.push_back(e.path().string());
+  FrameSource(const std::string& spec, double hfov_deg, const Config& cfg) : hfov_deg_(hfov_deg) {
+    std::error_code ec;
+    try {
+      if (fs::is_directory(spec, ec)) {
+        drivers::FolderCameraParams p;
+        p.hfov_deg = hfov_deg;
+        camera_ = std::make_unique<drivers::FolderCamera>(spec, p);
+        kind_ = Kind::Folder;
+      } else if (spec.find("://") != std::string::npos) {
+        drivers::registerDrivers();
+        sim::registerDrivers();
+        hw::DeviceContext ctx;
+        ctx.config = cfg;
+        camera_ = hw::Registry::instance().createCamera(spec, ctx);
+        kind_ = Kind::Uri;
+      } else if (fs::is_regular_file(spec, ec)) {
+        camera_ = std::make_unique<drivers::VideoCamera>(spec, hfov_deg);
+        kind_ = Kind::Video;
+      } else {
+        throw InputError("no such folder, file or URI");
       }
-      std::sort(files_.begin(), files_.end());
-      if (files_.empty()) throw InputError("--frames " + spec + ": no images in the folder");
-    } else if (spec.find("://") != std::string::npos) {
-      drivers::registerDrivers();
-      sim::registerDrivers();
-      hw::DeviceContext ctx;
-      ctx.config = cfg;
-      camera_ = hw::Registry::instance().createCamera(spec, ctx);
-    } else if (fs::is_regular_file(spec)) {
-      video_.open(spec);
-      if (!video_.isOpened()) throw InputError("--frames " + spec + ": cannot open as a video");
-    } else {
-      throw InputError("--frames " + spec + ": no such folder, file or URI");
+    } catch (const InputError& e) {
+      throw InputError("--frames " + spec + ": " + e.what());
     }
   }
 
-  /// Next frame; false at the end.
+  /// Next frame; false at the end (or when the camera fails: its error is logged).
   bool next(cv::Mat& img, std::string& name, hw::Intrinsics& k) {
-    if (!files_.empty()) {
-      if (index_ >= files_.size()) return false;
-      name = fs::path(files_[index_]).filename().string();
-      img = readImageFile(files_[index_++], "--frames image");  // grey files come as 3 channels
-    } else if (camera_) {
-      hw::Frame f;
-      for (;;) {
-        const auto st = camera_->grab(f, 2.0);
-        if (st == hw::GrabStatus::Ok) break;
-        if (st != hw::GrabStatus::Timeout) return false;
-      }
-      img = f.image;
-      name = f.source.empty() ? std::to_string(f.seq) : f.source;
-      k = camera_->intrinsics();
-      return true;
-    } else {
-      if (!video_.read(img) || img.empty()) return false;
-      name = std::to_string(video_index_++);
+    hw::Frame f;
+    for (;;) {
+      const auto st = camera_->grab(f, 2.0);
+      if (st == hw::GrabStatus::Ok) break;
+      if (st == hw::GrabStatus::Timeout) continue;  // a live camera may still deliver
+      if (st == hw::GrabStatus::Error)
+        log::warn("replay", "camera failed", {{"error", camera_->stats().last_error}});
+      return false;
     }
-    k = hw::Intrinsics::fromFov(img.cols, img.rows, hfov_);
+    img = f.image;
+    switch (kind_) {
+      case Kind::Folder:
+        name = fs::path(f.source).filename().string();
+        break;
+      case Kind::Video:
+        name = std::to_string(f.seq);
+        break;
+      case Kind::Uri:
+        name = f.source.empty() ? std::to_string(f.seq) : f.source;
+        k = camera_->intrinsics();
+        return true;
+    }
+    // Per frame: a folder may mix image sizes.
+    k = hw::Intrinsics::fromFov(img.cols, img.rows, hfov_deg_ * M_PI / 180.0);
     return true;
   }
+  /// Frames skipped as unreadable so far.
+  std::uint64_t dropped() const { return camera_->stats().dropped; }
 
  private:
-  std::vector<std::string> files_;
-  size_t index_ = 0;
-  long video_index_ = 0;
-  cv::VideoCapture video_;
+  enum class Kind { Folder, Video, Uri };
+  Kind kind_ = Kind::Folder;
   std::unique_ptr<hw::Camera> camera_;
-  double hfov_ = 1.0;
+  double hfov_deg_ = 60.0;
 };
 
 struct Row {
@@ -588,6 +600,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
                  {"detected", detected},
                  {"detection_rate", static_cast<double>(detected) / i},
                  {"target", target},
+                 {"dropped_frames", source.dropped()},  // unreadable, skipped with a warning
                  {"csv", out + "/replay.csv"},
                  {"contact_sheet", out + "/contact.png"}};
   if (!truth.empty()) {

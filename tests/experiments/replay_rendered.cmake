@@ -38,6 +38,7 @@ foreach(lm L1 L5)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "replay ${lm} failed (${rc}):\n${out}\n${err}")
   endif()
+  set(cls_${lm} ${cls})
   string(JSON agreement GET "${out}" agreement)
   string(JSON frames GET "${out}" truth_frames)
   message(STATUS "${lm} (${cls}): agreement ${agreement} over ${frames} frames")
@@ -58,3 +59,24 @@ foreach(lm L1 L5)
     message(FATAL_ERROR "replay.csv: expected a header + 15 rows, got ${n} lines")
   endif()
 endforeach()
+
+# Replay reads frames through the camera drivers: an unreadable frame in the folder is skipped
+# with a warning and counted (dropped_frames), as a run's folder camera does; the rest replay.
+file(COPY ${WORK}/L1/ DESTINATION ${WORK}/L1-corrupt FILES_MATCHING PATTERN "*.png")
+file(WRITE ${WORK}/L1-corrupt/frame_0007b.png "not a png")
+execute_process(COMMAND ${SN} --json replay --frames ${WORK}/L1-corrupt --target ${cls_L1}
+                        --model ${WORK}/set.slm --out ${WORK}/out-corrupt
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "replay with a corrupt frame failed (${rc}):\n${out}\n${err}")
+endif()
+string(JSON frames GET "${out}" frames)
+string(JSON dropped GET "${out}" dropped_frames)
+string(JSON detected GET "${out}" detected)
+if(NOT frames EQUAL 15 OR NOT dropped EQUAL 1 OR detected LESS 12)
+  message(FATAL_ERROR "expected 15 frames, 1 dropped, >= 12 detected: ${frames}, ${dropped}, "
+                      "${detected}\n${out}")
+endif()
+if(NOT err MATCHES "skipped unreadable frame")
+  message(FATAL_ERROR "no warning for the corrupt frame:\n${err}")
+endif()
