@@ -13,15 +13,17 @@
 #include <map>
 
 #include "cli.h"
-#include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
 #include "sketchnav/core/log.h"
 #include "sketchnav/landmarks/landmark_set.h"
 #include "sketchnav/landmarks/objectness.h"
 #include "sketchnav/landmarks/recognition.h"
+#include "sketchnav/run/plot.h"
 
 namespace sketchnav::app {
+using run::ConfusionSpec;
+using run::drawConfusionMatrix;
 namespace {
 
 namespace lm = landmarks;

@@ -12,7 +12,6 @@
 #include <sstream>
 
 #include "cli.h"
-#include "scenario_gen.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
@@ -21,10 +20,16 @@
 #include "sketchnav/run/judge.h"
 #include "sketchnav/run/run.h"
 #include "sketchnav/run/scenario.h"
+#include "sketchnav/run/scenario_gen.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world.h"
 
 namespace sketchnav::app {
+using run::GeneratedScenario;
+using run::generateScenario;
+using run::scenarioFamilies;
+using run::sketchErrorKinds;
+using run::writeScenario;
 namespace fs = std::filesystem;
 namespace {
 

@@ -13,15 +13,18 @@
 #include <sstream>
 
 #include "cli.h"
-#include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/run/experiments.h"
+#include "sketchnav/run/plot.h"
 #include "sketchnav/run/run.h"
 #include "sketchnav/run/scenario.h"
 #include "sketchnav/servo/turn_law.h"
 
 namespace sketchnav::app {
+using run::drawLinePlot;
+using run::plotColor;
+using run::PlotSpec;
 namespace fs = std::filesystem;
 namespace {
 

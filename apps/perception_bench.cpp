@@ -15,13 +15,17 @@
 #include <set>
 #include <sstream>
 
-#include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/image_file.h"
 #include "sketchnav/core/percentiles.h"
+#include "sketchnav/run/plot.h"
 
 namespace sketchnav::app::bench {
 namespace fs = std::filesystem;
+using run::drawLinePlot;
+using run::plotColor;
+using run::PlotSeries;
+using run::PlotSpec;
 
 const std::vector<double> kYawBins{0, 15, 30, 45, 60};
 const std::vector<double> kWidthBins{60, 100, 150, 300};

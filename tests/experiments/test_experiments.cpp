@@ -9,15 +9,20 @@
 #include <map>
 #include <set>
 
-#include "plot.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
 #include "sketchnav/mapsketch/route.h"
 #include "sketchnav/run/experiments.h"
+#include "sketchnav/run/plot.h"
 #include "sketchnav/sim/world.h"
 
 namespace sketchnav::app {
+using run::ConfusionSpec;
+using run::drawConfusionMatrix;
+using run::drawLinePlot;
+using run::plotColor;
+using run::PlotSpec;
 // The experiment model is the run library's (run/experiments.h); the plot writer is the app's.
 using run::makeSketch;
 using run::makeVariant;

@@ -1,4 +1,4 @@
-// The scenario generator (apps/scenario_gen.h): every family, seeded and reproducible, every
+// The scenario generator (run/scenario_gen.h): every family, seeded and reproducible, every
 // scenario passing the world and sketch checks, and the drawing errors within their bounds
 // (measured on the files, not only read back from the record). No simulation.
 #include <gtest/gtest.h>
@@ -8,16 +8,16 @@
 #include <map>
 #include <set>
 
-#include "scenario_gen.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/mapsketch/io.h"
+#include "sketchnav/run/scenario_gen.h"
 #include "sketchnav/sim/simulator.h"
 #include "sketchnav/sim/world.h"
 #include "sketchnav/sim/world_check.h"
 
 using namespace sketchnav;
-using app::GeneratedScenario;
+using run::GeneratedScenario;
 
 namespace {
 
@@ -29,35 +29,35 @@ std::vector<std::string> demoClasses() {
 
 TEST(ScenarioGenerator, EveryFamilyPassesTheChecks) {
   const auto classes = demoClasses();
-  for (const auto& fam : app::scenarioFamilies())
+  for (const auto& fam : run::scenarioFamilies())
     for (std::uint64_t seed = 1; seed <= 6; ++seed) {
-      const GeneratedScenario s = app::generateScenario(fam, seed, classes);
-      EXPECT_TRUE(app::scenarioProblems(s, classes).empty()) << s.name;
+      const GeneratedScenario s = run::generateScenario(fam, seed, classes);
+      EXPECT_TRUE(run::scenarioProblems(s, classes).empty()) << s.name;
       EXPECT_TRUE(s.warnings.empty()) << s.name << ": " << s.warnings.front();
     }
 }
 
 TEST(ScenarioGenerator, SameFamilyAndSeedGiveTheSameFilesOtherSeedsOthers) {
   const auto classes = demoClasses();
-  for (const auto& fam : app::scenarioFamilies()) {
-    const GeneratedScenario a = app::generateScenario(fam, 42, classes);
-    const GeneratedScenario b = app::generateScenario(fam, 42, classes);
-    const GeneratedScenario c = app::generateScenario(fam, 43, classes);
+  for (const auto& fam : run::scenarioFamilies()) {
+    const GeneratedScenario a = run::generateScenario(fam, 42, classes);
+    const GeneratedScenario b = run::generateScenario(fam, 42, classes);
+    const GeneratedScenario c = run::generateScenario(fam, 43, classes);
     EXPECT_EQ(a.world.dump(), b.world.dump()) << fam;
     EXPECT_EQ(a.sketch.dump(), b.sketch.dump()) << fam;
     EXPECT_EQ(a.toJson().dump(), b.toJson().dump()) << fam;
     EXPECT_NE(a.world.dump(), c.world.dump()) << fam;
     EXPECT_EQ(a.name, fam + "-42");
   }
-  EXPECT_THROW(app::generateScenario("castle", 1, classes), InputError);
+  EXPECT_THROW(run::generateScenario("castle", 1, classes), InputError);
 }
 
 TEST(ScenarioGenerator, WorldsHaveWhatTheirFamilyPromises) {
   const auto classes = demoClasses();
   int people = 0, aside = 0, in_way = 0, on_furniture = 0, doors = 0, closed = 0;
   for (std::uint64_t seed = 1; seed <= 12; ++seed)
-    for (const auto& fam : app::scenarioFamilies()) {
-      const GeneratedScenario s = app::generateScenario(fam, seed, classes);
+    for (const auto& fam : run::scenarioFamilies()) {
+      const GeneratedScenario s = run::generateScenario(fam, seed, classes);
       const sim::World w = sim::worldFromJson(s.world, s.name, resourceDir());
       EXPECT_GE(w.landmarks.size(), 2u) << s.name;
       EXPECT_GE(w.walls.size(), 4u) << s.name;
@@ -97,11 +97,11 @@ TEST(ScenarioGenerator, WorldsHaveWhatTheirFamilyPromises) {
 // against the true distance, a moved landmark against where the sketch remembers it.
 TEST(ScenarioGenerator, SketchErrorsAreWithinTheirBounds) {
   const auto classes = demoClasses();
-  const app::SketchErrorBounds B;
+  const run::SketchErrorBounds B;
   std::map<std::string, int> applied;
   for (std::uint64_t seed = 100; seed < 130; ++seed)
-    for (const auto& fam : app::scenarioFamilies()) {
-      const GeneratedScenario s = app::generateScenario(fam, seed, classes);
+    for (const auto& fam : run::scenarioFamilies()) {
+      const GeneratedScenario s = run::generateScenario(fam, seed, classes);
       const sim::World w = sim::worldFromJson(s.world, s.name, resourceDir());
       double bias = 1;
       std::set<std::string> moved, missing;
@@ -163,7 +163,7 @@ TEST(ScenarioGenerator, SketchErrorsAreWithinTheirBounds) {
       }
     }
   // Every kind is drawn in this sample (p = 0.4 each over 120 scenarios).
-  for (const auto& k : app::sketchErrorKinds()) EXPECT_GT(applied[k], 5) << k;
+  for (const auto& k : run::sketchErrorKinds()) EXPECT_GT(applied[k], 5) << k;
 }
 
 // Every landmark can be seen: rendered from 1 m in front of it (camera pitched at it), the view
@@ -173,8 +173,8 @@ TEST(ScenarioGenerator, EveryLandmarkIsVisibleFromInFrontOfIt) {
   const auto classes = demoClasses();
   int checked = 0;
   for (std::uint64_t seed = 1; seed <= 3; ++seed)
-    for (const auto& fam : app::scenarioFamilies()) {
-      const GeneratedScenario s = app::generateScenario(fam, seed, classes);
+    for (const auto& fam : run::scenarioFamilies()) {
+      const GeneratedScenario s = run::generateScenario(fam, seed, classes);
       const sim::World w = sim::worldFromJson(s.world, s.name, resourceDir());
       for (size_t i = 0; i < w.landmarks.size(); ++i) {
         const sim::Landmark& l = w.landmarks[i];

@@ -12,8 +12,7 @@ endforeach()
 
 # Unit tests of the variant generator and the plot writer (fast, no simulation).
 sketchnav_add_test(test_experiments
-  SOURCES ${EXP_DIR}/test_experiments.cpp ${PROJECT_SOURCE_DIR}/apps/plot.cpp
-          ${PROJECT_SOURCE_DIR}/apps/scenario_gen.cpp ${EXP_DIR}/test_scenarios.cpp
+  SOURCES ${EXP_DIR}/test_experiments.cpp ${EXP_DIR}/test_scenarios.cpp
   LINK sketchnav::run sketchnav::core sketchnav::sim sketchnav::mapsketch opencv_imgproc
   LABELS experiments)
 if(TARGET test_experiments)

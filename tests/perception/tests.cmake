@@ -3,8 +3,8 @@
 # a small generated slice through the command (skipped when the shared data is absent).
 sketchnav_add_test(test_perception_bench
   SOURCES ${CMAKE_CURRENT_SOURCE_DIR}/perception/test_perception_bench.cpp
-          ${PROJECT_SOURCE_DIR}/apps/perception_bench.cpp ${PROJECT_SOURCE_DIR}/apps/plot.cpp
-  LINK sketchnav::core sketchnav::servo opencv_imgproc opencv_imgcodecs
+          ${PROJECT_SOURCE_DIR}/apps/perception_bench.cpp
+  LINK sketchnav::run sketchnav::core sketchnav::servo opencv_imgproc opencv_imgcodecs
   LABELS perception)
 if(TARGET test_perception_bench)
   target_include_directories(test_perception_bench PRIVATE ${PROJECT_SOURCE_DIR}/apps

@@ -4,7 +4,7 @@
 // faces or on furniture faces / tops along the route; furniture stands off the route; people
 // walk on straight stretches of it. The sketch is the intended route and landmarks through a
 // person's drawing errors.
-#include "scenario_gen.h"
+#include "sketchnav/run/scenario_gen.h"
 
 #include <algorithm>
 #include <cmath>
@@ -24,7 +24,7 @@
 #include "sketchnav/sim/world.h"
 #include "sketchnav/sim/world_check.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 namespace {
 
 using V2 = Eigen::Vector2d;
@@ -1190,4 +1190,4 @@ std::string writeScenario(const GeneratedScenario& s, const std::string& dir) {
   return base + ".world.json";
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

@@ -17,7 +17,7 @@
 
 #include "sketchnav/core/config.h"
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 
 /// Bounds of the drawing errors; each kind is applied to a scenario with probability `p_kind`.
 /// An applied rotation is at least 5 deg, a start heading error at least 5 deg, a distance
@@ -80,4 +80,4 @@ std::vector<std::string> scenarioProblems(const GeneratedScenario& s,
 /// returns the world file's path.
 std::string writeScenario(const GeneratedScenario& s, const std::string& dir);
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

@@ -1,4 +1,4 @@
-#include "plot.h"
+#include "sketchnav/run/plot.h"
 
 #include <opencv2/imgproc.hpp>
 
@@ -6,7 +6,7 @@
 #include <cmath>
 #include <cstdio>
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 namespace {
 
 // "Nice" tick step for a range (1, 2, 5 x 10^k), about `n` ticks.
@@ -200,4 +200,4 @@ cv::Mat drawConfusionMatrix(const ConfusionSpec& spec) {
   return img;
 }
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run

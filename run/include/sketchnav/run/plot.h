@@ -6,7 +6,7 @@
 #include <string>
 #include <vector>
 
-namespace sketchnav::app {
+namespace sketchnav::run {
 
 struct PlotSeries {
   std::string label;
@@ -40,4 +40,4 @@ cv::Mat drawConfusionMatrix(const ConfusionSpec& spec);
 /// A distinct colour for series i.
 cv::Scalar plotColor(int i);
 
-}  // namespace sketchnav::app
+}  // namespace sketchnav::run
