@@ -254,9 +254,23 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   const Side s_pos = side(1), s_neg = side(-1);
   const int own = so >= 0 ? 1 : -1;
   const Side& own_side = own > 0 ? s_pos : s_neg;
+  const Side& across = own > 0 ? s_neg : s_pos;
+  // When the walker's body reaches the robot's along their line, at their speed.
+  const double walker_speed = walker_.vel.norm();
+  const double arrive_s = std::max(0.0, (Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos).dot(u) -
+                                            (P.robot_radius_m + P.person_radius_m)) /
+                          std::max(walker_speed, 0.05);
+  // A side kept is a side of the floor, not of the walker: when their heading turns round
+  // (a walker who turns back, or is first estimated walking the wrong way), "their left" is
+  // the other side, and a sign kept would send the robot across their line (generated
+  // corridor-1: a walker turned 0.7 m from the robot and it drove 0.4 m towards their axis).
+  if (lane_sign_ != 0) lane_sign_ = lane_side_.dot(perp) >= 0 ? 1 : -1;
   if (lane_sign_ == 0 && std::abs(so) >= 0.15 &&
-      own_side.reach >= P.robot_radius_m + P.person_radius_m + 0.1) {
-    // Off the axis with room on that side: that side (going across is crossing in front).
+      (own_side.reach >= P.robot_radius_m + P.person_radius_m + 0.1 || across.time >= arrive_s)) {
+    // Off the axis: that side when it has room, and also when it has not but going across
+    // (crossing in front of the walker) would not be over before they get there: standing
+    // at the edge of their way is a near miss, being in the middle of it when they arrive is
+    // a collision.
     lane_sign_ = own;
   } else if (lane_sign_ == 0) {
     // Near the axis: the side that leaves the larger gap; where both leave the lane (or about
@@ -279,6 +293,7 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
       lane_sign_ = -lane_sign_;
   }
   const Side& goal = lane_sign_ > 0 ? s_pos : s_neg;
+  lane_side_ = lane_sign_ * perp;
   const Eigen::Vector2d n = lane_sign_ * perp, nr = toRobot(n);
   const double now_off = lane_sign_ * so;
   side_ = nr.y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
@@ -374,7 +389,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
       if (have_prev_pt_ && dt > 1e-6 && dt < 0.5 && (world - prev_pt_).norm() < 0.3) {
         const Eigen::Vector2d vel = (world - prev_pt_) / dt;
         const Eigen::Vector2d los = (world - robot).normalized();
-        double rate = -vel.dot(los);  // > 0: coming towards the robot
+        double rate = -vel.dot(los);                               // > 0: coming towards the robot
         if (rate > 0 && moved_in_ && !moved_in_(world)) rate = 0;  // static: it slid
         approach_ = 0.6 * approach_ + 0.4 * std::clamp(rate, -2.0, 2.0);
       } else {

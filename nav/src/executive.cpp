@@ -848,6 +848,28 @@ struct Executive::Impl {
         yielding = false;
         event(event::YieldEnd{});
       }
+    } else if (!dev.ranges.empty() && status == RunStatus::Running) {
+      // Lanes off: still, whatever drives does not take the robot into the lane of someone
+      // walking (the tracker's walkers, not every mover): it waits for them to pass. (A
+      // dodge that ended as the walker's track dropped out for a scan handed the robot back
+      // to the route, which crossed the lane 1 m in front of them.)
+      const Command cur = arb.winner();
+      const auto adv = movers.holdShortOfWalkerLanes(pose, cur.v, cur.w);
+      if (adv.active) {
+        Command c = cur;
+        c.v = 0;
+        c.turn = turnOf(c.w);
+        arb.propose(Behaviour::Yield, c);
+        if (!yielding) {
+          yielding = true;
+          ++yields;
+          event(event::YieldStart{false, adv.clearance_m, adv.mover.position, adv.mover.velocity,
+                                  pose});
+        }
+      } else if (yielding) {
+        yielding = false;
+        event(event::YieldEnd{});
+      }
     }
     if (final_looking) {
       // Turn on the spot to where the sketch puts the landmark (perception attends it once it

@@ -54,8 +54,12 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
   Cluster cur;
   Eigen::Vector2d prev(0, 0);
   bool have_prev = false;
+  // A cluster of one or two beams is no body within range_m (a person 4 m off spans 7 beams
+  // of 1 deg): it is a surface seen at a grazing angle, each beam its own cluster, or a beam
+  // split off an edge. Tracked, such fragments of a wall slid along it as the robot drove,
+  // came towards it and were taken for walkers.
   auto close = [&]() {
-    if (cur.n > 0 && (cur.last - cur.first).norm() <= p_.max_width_m) clusters.push_back(cur);
+    if (cur.n >= 3 && (cur.last - cur.first).norm() <= p_.max_width_m) clusters.push_back(cur);
     cur = Cluster{};
   };
   const size_t n = std::min(s.angles.size(), s.ranges.size());
@@ -80,24 +84,43 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
   }
   close();
 
-  // Associate with the tracks' predictions (nearest first), then filter position and
-  // velocity (alpha-beta).
+  // Associate with the tracks' predictions, nearest pair first over all clusters and tracks,
+  // then filter position and velocity (alpha-beta). (Taken cluster by cluster in beam order, a
+  // one-beam fragment split off a person's edge came first, took their track 0.3 m off its
+  // prediction, and the person went on as a new track: 0.5 s without a walker.)
   const double t = s.stamp;
-  std::vector<bool> used(tracks_.size(), false);
-  std::vector<Track> born;
+  std::vector<Eigen::Vector2d> centres;
+  centres.reserve(clusters.size());
   for (const auto& cl : clusters) {
     const Eigen::Vector2d z = cl.sum / cl.n;
     // Where the beams hit is the near surface: the body's centre is further away.
-    const Eigen::Vector2d centre =
-        z + (z - Eigen::Vector2d(robot.x, robot.y)).normalized() * 0.5 * p_.person_radius_m;
-    int best = -1;
-    double bd = p_.gate_m;
+    centres.push_back(z + (z - Eigen::Vector2d(robot.x, robot.y)).normalized() * 0.5 *
+                              p_.person_radius_m);
+  }
+  struct Pair {
+    double d;
+    size_t c, k;
+  };
+  std::vector<Pair> pairs;
+  for (size_t c = 0; c < clusters.size(); ++c)
     for (size_t k = 0; k < tracks_.size(); ++k) {
-      if (used[k]) continue;
       const Eigen::Vector2d pred = tracks_[k].pos + tracks_[k].vel * (t - tracks_[k].t);
-      const double d = (pred - centre).norm();
-      if (d < bd) bd = d, best = static_cast<int>(k);
+      const double d = (pred - centres[c]).norm();
+      if (d < p_.gate_m) pairs.push_back({d, c, k});
     }
+  std::sort(pairs.begin(), pairs.end(), [](const Pair& a, const Pair& b) {
+    return a.d != b.d ? a.d < b.d : (a.c != b.c ? a.c < b.c : a.k < b.k);
+  });
+  std::vector<int> track_of(clusters.size(), -1);
+  std::vector<bool> used(tracks_.size(), false);
+  for (const auto& pr : pairs)
+    if (track_of[pr.c] < 0 && !used[pr.k])
+      track_of[pr.c] = static_cast<int>(pr.k), used[pr.k] = true;
+  std::vector<Track> born;
+  for (size_t c = 0; c < clusters.size(); ++c) {
+    const auto& cl = clusters[c];
+    const Eigen::Vector2d centre = centres[c];
+    const int best = track_of[c];
     const bool on_free = 2 * cl.free > cl.n;
     if (best < 0) {
       Track tr;
@@ -111,7 +134,6 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
       born.push_back(tr);
       continue;
     }
-    used[best] = true;
     Track& tr = tracks_[best];
     const double dt = t - tr.t;
     if (dt <= 1e-6) continue;
@@ -145,6 +167,11 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
         tr.steady = std::sqrt(ss / m) <= 0.06;
       }
     }
+    const Eigen::Vector2d to_robot = Eigen::Vector2d(robot.x, robot.y) - tr.pos;
+    const double sp = tr.fit_vel.norm();
+    const bool coming = tr.steady && sp >= p_.min_speed && sp <= 1.2 &&
+                        tr.fit_vel.dot(to_robot) >= std::cos(M_PI / 4) * sp * to_robot.norm();
+    tr.coming_in_row = coming ? tr.coming_in_row + 1 : 0;
   }
   tracks_.erase(std::remove_if(tracks_.begin(), tracks_.end(),
                                [&](const Track& tr) { return t - tr.t > p_.forget_s; }),
@@ -181,8 +208,10 @@ std::vector<Mover> MoverTracker::walkers() const {
     const double sp = tr.fit_vel.norm();
     const int recent = std::min(tr.updates, 16);
     const int recent_free = std::bitset<16>(tr.free_bits).count();
-    if (tr.steady && 4 * recent_free >= 3 * recent && tr.updates >= 3 * p_.min_updates &&
-        sp >= 1.5 * p_.min_speed && sp <= 1.2)
+    const bool on_free_floor = tr.steady && 4 * recent_free >= 3 * recent &&
+                               tr.updates >= 3 * p_.min_updates && sp >= 1.5 * p_.min_speed &&
+                               sp <= 1.2;
+    if (on_free_floor || tr.coming_in_row >= 2 * p_.min_updates)
       out.push_back({tr.pos, tr.fit_vel, tr.updates});
   }
   return out;
@@ -243,7 +272,14 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
     }
   }
   // Not in a lane: would the command take the robot into one within look_ahead_s?
+  return holdShort(ms, robot, v, w, a);
+}
+
+YieldAdvice MoverTracker::holdShort(const std::vector<Mover>& ms, const hw::Pose2D& robot, double v,
+                                    double w, YieldAdvice a) const {
   if (v <= 0) return a;
+  const double R = p_.person_radius_m + p_.robot_radius_m + p_.margin_m;
+  const Eigen::Vector2d P(robot.x, robot.y);
   for (const auto& m : ms) {
     if ((m.position - P).norm() > p_.range_m) continue;
     double x = robot.x, y = robot.y, th = robot.theta;
@@ -264,6 +300,23 @@ YieldAdvice MoverTracker::advise(const hw::Pose2D& robot, double v, double w, do
     }
   }
   return a;
+}
+
+YieldAdvice MoverTracker::holdShortOfWalkerLanes(const hw::Pose2D& robot, double v,
+                                                 double w) const {
+  const std::vector<Mover> ws = walkers();
+  const double R = p_.person_radius_m + p_.robot_radius_m + p_.margin_m;
+  const Eigen::Vector2d P(robot.x, robot.y);
+  YieldAdvice a;
+  a.clearance_m = 1e9;
+  for (const auto& m : ws) {
+    if ((m.position - P).norm() > p_.range_m) continue;
+    a.clearance_m =
+        std::min(a.clearance_m, (m.position - P).norm() - p_.person_radius_m - p_.robot_radius_m);
+    // Already in one: the avoider steps out of it (ObstacleAvoider::offerWalker).
+    if (segDist(P, m.position, m.position + m.velocity * p_.horizon_s) < R) return YieldAdvice{};
+  }
+  return holdShort(ws, robot, v, w, a);
 }
 
 }  // namespace sketchnav::nav

@@ -293,8 +293,7 @@ CorridorMeet meetInCorridor(double half_width, double lane_y, double speed, doub
     // Route following: towards the centre line 1.5 m ahead.
     const double tb = std::remainder(std::atan2(-pose.y, 1.5) - pose.theta, 2 * M_PI);
     a.setPose(pose);
-    if (std::hypot(wx - pose.x, lane_y - pose.y) < 4.0)
-      a.offerWalker({wx, lane_y}, {vx, 0.0});
+    if (std::hypot(wx - pose.x, lane_y - pose.y) < 4.0) a.offerWalker({wx, lane_y}, {vx, 0.0});
     const auto scan = test::scanAt(pose, walls, {walker}, t);
     const auto out = a.step({scan}, tb, DodgeSide::Left, pose.theta, 0.3, t);
     const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
@@ -370,6 +369,71 @@ TEST(Avoider, StepsOutOfTheLaneOfAWalkerTheTrackerSawComingFromTheSide) {
     EXPECT_FALSE(out.in_lane) << v.transpose();
     EXPECT_FALSE(out.active) << v.transpose();
   }
+}
+
+TEST(Avoider, DoesNotCrossInFrontOfAWalkerItCannotGetPastInTime) {
+  // A generated mixed route: the robot stands 0.57 m south of a walker's axis with a wall
+  // close on its south side (no room to get further out), the walker coming west at 0.4 m/s.
+  // The north side has room, but getting there means crossing their line (1.4 m sideways,
+  // about 5 s): when they arrive sooner, standing at the edge of their way it is passed
+  // clear; when later, it gets across.
+  const std::vector<test::Box> wall{{2.0, -0.45, 4.0, 0.15}};  // inner face at y = -0.3
+  for (const double start_x : {2.5, 3.5}) {
+    ObstacleAvoider a;
+    hw::Pose2D pose{0, 0, 0};
+    double min_gap = 1e9, max_y = -1e9;
+    for (int k = 0; k < 150; ++k) {
+      const double t = 0.1 * k;
+      const Eigen::Vector2d wp(start_x - 0.4 * t, 0.57);
+      min_gap = std::min(min_gap, std::hypot(wp.x() - pose.x, wp.y() - pose.y) - 0.45);
+      if (wp.x() > pose.x) max_y = std::max(max_y, pose.y);
+      a.setPose(pose);
+      if (wp.x() > pose.x - 0.5) a.offerWalker(wp, {-0.4, 0.0});
+      const auto scan = test::scanAt(pose, wall, {{wp.x(), wp.y(), 0.25}}, t);
+      const double tb = std::remainder(std::atan2(-pose.y, 1.5) - pose.theta, 2 * M_PI);
+      const auto out = a.step({scan}, tb, DodgeSide::Left, pose.theta, 0.3, t);
+      const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
+      const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
+      pose.x += v * std::cos(pose.theta) * 0.1;
+      pose.y += v * std::sin(pose.theta) * 0.1;
+      pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+    }
+    if (start_x < 3.0) {
+      // Across takes ~6 s, they arrive in 5.1 s: without this rule it went and was walked
+      // into (gap -0.03 m).
+      EXPECT_GT(min_gap, 0.05) << "start " << start_x;
+      EXPECT_LT(max_y, 0.15) << "start " << start_x << ": went across in front of the walker";
+    } else {
+      // 7.6 s: time to get across, to the side with room for the full gap.
+      EXPECT_GE(min_gap, 0.3) << "start " << start_x;
+    }
+  }
+}
+
+TEST(Avoider, KeepsToItsSideOfTheFloorWhenTheWalkersHeadingTurnsRound) {
+  // The robot stands 0.6 m south of a walker's axis (y = 0.6), in their lane. A walker comes
+  // west from 1.5 m east: it steps out south, its own side. Then (0.7 s later, the side still
+  // kept) a walker on the same axis comes east from 1.5 m west — as when a walker turns back,
+  // or their heading is first estimated the wrong way round. South is still the way out:
+  // kept as "the walker's right" it became north, across their line (generated corridor-1).
+  ObstacleAvoider a;
+  const hw::Pose2D pose{0, 0, 0};
+  auto stepWith = [&](const std::vector<test::Disc>& walkers, double t) {
+    a.setPose(pose);
+    return a.step({test::scanAt(pose, {}, walkers, t)}, 0.0, DodgeSide::Left, 0.0, 0.3, t);
+  };
+  stepWith({{1.5, 0.6, 0.25}}, 0.0);
+  a.offerWalker({1.5, 0.6}, {-0.4, 0.0});
+  const auto first = stepWith({{1.46, 0.6, 0.25}}, 0.1);
+  ASSERT_TRUE(first.in_lane);
+  EXPECT_LT(std::sin(first.direction), -0.5) << "first walker: out to the south";
+  double t = 0.2;
+  for (; t < 0.95; t += 0.1) stepWith({}, t);  // nobody in view: the walker is dropped
+  stepWith({{-1.5, 0.6, 0.25}}, t);
+  a.offerWalker({-1.5, 0.6}, {0.4, 0.0});
+  const auto second = stepWith({{-1.46, 0.6, 0.25}}, t + 0.1);
+  ASSERT_TRUE(second.in_lane);
+  EXPECT_LT(std::sin(second.direction), -0.5) << "second walker: still out to the south";
 }
 
 TEST(Avoider, LeavesALaneOnTheSideItFacesWhenNearTheAxis) {

@@ -46,6 +46,33 @@ TEST(Movers, AWalkingPersonIsAMoverWithItsVelocity) {
   EXPECT_NEAR(m[0].position.y(), 2.0 - 0.4 * 3.0, 0.25);
 }
 
+TEST(Movers, AWalkerStaysOneTrackWhenABeamSplitsOffTheirEdge) {
+  // Walking across 3 m in front of the robot, the beam grazing the person's edge lands far
+  // enough along the body to make a one-beam cluster of its own (at y ~ 1.1 here). Taken first,
+  // it used to steal their track, and they were no walker for 1.4 s; once a walker, they stay
+  // one.
+  LocalPlanner grid;
+  const hw::Pose2D robot{0, 0, 0};
+  auto boxes = room();
+  for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
+  MoverTracker tr(MoverParams{});
+  const LocalPlanner before = grid.snapshot();
+  bool walker = false;
+  for (double t = 0.5; t <= 4.5 + 1e-9; t += 0.1) {
+    const Eigen::Vector2d p(3.0, 2.0 - 0.4 * (t - 0.5));
+    const auto s = scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t);
+    tr.update(robot, s, before);
+    grid.insert(robot, s);
+    const auto w = tr.walkers();
+    if (walker) {
+      ASSERT_EQ(w.size(), 1u) << "t=" << t << " y=" << p.y();
+      EXPECT_NEAR(w[0].position.y(), p.y(), 0.15) << "t=" << t;
+    }
+    walker = walker || !w.empty();
+  }
+  EXPECT_TRUE(walker);
+}
+
 TEST(Movers, WalkersForTheAvoiderAreTrackedForLongerAtAWalkingPace) {
   LocalPlanner g1, g2, g3;
   // 1 s after coming into view a mover, not yet a walker; after 2 s both.
@@ -86,6 +113,64 @@ TEST(Movers, AWalkerWhoStoodWhereTheGridSawThemIsTakenOnceWalkingOnFreeFloor) {
   EXPECT_NEAR(tr.walkers()[0].velocity.x(), -0.4, 0.1);
 }
 
+TEST(Movers, AWalkerComingBackAlongTheirOwnTraceIsTakenWhileComingAtTheRobot) {
+  // A person in front of the robot from the start walks away along a line, turns and walks
+  // back towards it. Going away, the side of them in view sweeps floor their body hid (never
+  // seen free); coming back, it sweeps their own trace, which the grid of a few seconds ago
+  // holds occupied. (A slow walker turning in a corridor was taken only when 0.8 m from the
+  // robot, and walked into it.) Coming back they are a walker within 2 s of turning.
+  LocalPlanner grid;
+  const hw::Pose2D robot{0, 0, 0};
+  auto boxes = room();
+  MoverTracker tr(MoverParams{});
+  LocalPlanner before = grid.snapshot(), snap = grid.snapshot();
+  double snap_t = 0.5;
+  const Eigen::Vector2d start(1.5, 0.2), vel(0.35, 0.0);
+  const double turn_t = 0.5 + 6.0;  // 2.1 m away, then back
+  double taken_at = -1;
+  for (double t = 0.5; t <= turn_t + 4.0 + 1e-9; t += 0.1) {
+    const Eigen::Vector2d p =
+        t <= turn_t ? Eigen::Vector2d(start + vel * (t - 0.5))
+                    : Eigen::Vector2d(start + vel * (turn_t - 0.5) - vel * (t - turn_t));
+    const auto s = scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t);
+    tr.update(robot, s, before);
+    grid.insert(robot, s);
+    if (t - snap_t >= 1.5) before = std::move(snap), snap = grid.snapshot(), snap_t = t;
+    const auto w = tr.walkers();
+    if (t <= turn_t) {
+      for (const auto& m : w) EXPECT_GT(m.velocity.x(), 0.2) << "t=" << t;  // going away
+    } else if (taken_at < 0 && !w.empty() && w[0].velocity.x() < -0.2) {
+      taken_at = t;
+    }
+  }
+  ASSERT_GT(taken_at, 0) << "the walker coming back was never taken";
+  EXPECT_LE(taken_at - turn_t, 2.0);  // on free floor only: 3.5 s
+  const auto w = tr.walkers();
+  ASSERT_EQ(w.size(), 1u);
+  EXPECT_NEAR(w[0].velocity.x(), -0.35, 0.1);
+}
+
+TEST(Movers, WithLanesOffTheRobotStillHoldsShortOfAWalkersLane) {
+  // Lane keeping off (the default): a command that would take the robot into the lane of a
+  // walker (not merely a mover) within look_ahead_s waits, turning kept; one in the lane
+  // already is the avoider's (no advice); standing still needs none.
+  LocalPlanner g1, g2;
+  const auto tr = watch(g1, {0, 0, 0}, {3.0, 2.0}, {0.0, -0.4}, 2.0, false);
+  ASSERT_EQ(tr.walkers().size(), 1u);  // at about (3, 1.2), walking south
+  const auto hold = tr.holdShortOfWalkerLanes({2.0, 0.0, 0.0}, 0.3, 0.1);
+  EXPECT_TRUE(hold.active);
+  EXPECT_EQ(hold.v, 0.0);
+  EXPECT_EQ(hold.w, 0.1);
+  EXPECT_FALSE(tr.holdShortOfWalkerLanes({1.0, 0.0, 0.0}, 0.3, 0.0).active);  // not that soon
+  EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.0, 0.0, M_PI}, 0.3, 0.0).active);  // driving off
+  EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.8, 0.0, 0.0}, 0.3, 0.0).active);   // in it already
+  EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.0, 0.0, 0.0}, 0.0, 0.5).active);   // not driving
+  // A mover seen for 1 s is not a walker yet: no hold.
+  const auto early = watch(g2, {0, 0, 0}, {3.0, 1.4}, {0.0, -0.4}, 1.0, false);
+  ASSERT_TRUE(early.walkers().empty());
+  EXPECT_FALSE(early.holdShortOfWalkerLanes({2.0, 0.0, 0.0}, 0.3, 0.0).active);
+}
+
 TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
   LocalPlanner grid;
   MoverParams on;
@@ -102,6 +187,7 @@ TEST(Movers, FurnitureIsNotAMoverEvenWhileTheRobotDrives) {
     if (std::fmod(t + 1e-9, 1.0) < 0.05) before = grid.snapshot();  // as the executive does
   }
   EXPECT_TRUE(tr.movers().empty());
+  EXPECT_TRUE(tr.walkers().empty());
 }
 
 TEST(Movers, InTheLaneTheRobotStepsOutOnItsOwnSide) {

@@ -98,6 +98,12 @@ class MoverTracker {
   /// three quarters of their last 16 points on floor seen free; unlike movers(), the first
   /// need not be: a person already walking when first in view (the lab's walker, seen first across
   /// the room) is first seen where the grid had not yet seen the floor.
+  /// Also, wherever its points lie, a track that has come steadily towards the robot (its
+  /// velocity within 45 deg of the line to the robot at the last scan, at min_speed to
+  /// 1.2 m/s) over its last 2 x min_updates scans: a person walking back along the line they
+  /// came by walks over their own trace, which the grid of a few seconds ago holds occupied.
+  /// The things the free-floor test is there for (occlusion edges sliding along a wall as the
+  /// robot drives or turns) move with the robot or across its line of sight, not at it.
   std::vector<Mover> walkers() const;
   /// The forward speed at most `v` that keeps follow_gap_m behind a track walking away from
   /// the robot in its way (ahead, within both bodies' width of its heading line, steady over
@@ -107,6 +113,11 @@ class MoverTracker {
   /// step out of one it is in. `k_heading`, `v_max`: how it turns and how fast it may go.
   YieldAdvice advise(const hw::Pose2D& robot, double v, double w, double k_heading,
                      double v_max) const;
+  /// The part of advise() that holds the robot short of a lane, for walkers() only and
+  /// whether or not `enabled`: a command (v, w) that would take a robot at `robot` into a
+  /// walker's lane within look_ahead_s is to wait (active, v = 0, w kept). Inactive while
+  /// the robot is in a walker's lane already: stepping out of it is the avoider's.
+  YieldAdvice holdShortOfWalkerLanes(const hw::Pose2D& robot, double v, double w) const;
   const MoverParams& params() const { return p_; }
 
  private:
@@ -120,7 +131,10 @@ class MoverTracker {
     std::vector<std::pair<double, Eigen::Vector2d>> history;  // (stamp, centre), last 1.2 s
     Eigen::Vector2d fit_vel{0, 0};                            // straight-line fit over the history
     bool steady = false;                                      // and the fit is good (RMS <= 6 cm)
+    int coming_in_row = 0;  // consecutive updates steady and coming towards the robot
   };
+  YieldAdvice holdShort(const std::vector<Mover>& ms, const hw::Pose2D& robot, double v, double w,
+                        YieldAdvice a) const;
   MoverParams p_;
   std::vector<Track> tracks_;
 };
