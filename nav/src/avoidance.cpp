@@ -260,42 +260,43 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   const double arrive_s = std::max(0.0, (Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos).dot(u) -
                                             (P.robot_radius_m + P.person_radius_m)) /
                           std::max(walker_speed, 0.05);
-  // A side kept is a side of the floor, not of the walker: when their heading turns round
-  // (a walker who turns back, or is first estimated walking the wrong way), "their left" is
-  // the other side, and a sign kept would send the robot across their line (generated
-  // corridor-1: a walker turned 0.7 m from the robot and it drove 0.4 m towards their axis).
-  if (lane_sign_ != 0) lane_sign_ = lane_side_.dot(perp) >= 0 ? 1 : -1;
-  if (lane_sign_ == 0 && std::abs(so) >= 0.15 &&
+  // The side kept (lane_side_) is a direction on the floor, not the walker's left or right:
+  // when their heading turns round (a walker who turns back, or is first estimated walking
+  // the wrong way), "their left" is the other side, and a sign kept would send the robot
+  // across their line (generated corridor-1: a walker turned 0.7 m from the robot and it
+  // drove 0.4 m towards their axis).
+  int lane_sign = lane_side_.isZero() ? 0 : (lane_side_.dot(perp) >= 0 ? 1 : -1);
+  if (lane_sign == 0 && std::abs(so) >= 0.15 &&
       (own_side.reach >= P.robot_radius_m + P.person_radius_m + 0.1 || across.time >= arrive_s)) {
     // Off the axis: that side when it has room, and also when it has not but going across
     // (crossing in front of the walker) would not be over before they get there: standing
     // at the edge of their way is a near miss, being in the middle of it when they arrive is
     // a collision.
-    lane_sign_ = own;
-  } else if (lane_sign_ == 0) {
+    lane_sign = own;
+  } else if (lane_sign == 0) {
     // Near the axis: the side that leaves the larger gap; where both leave the lane (or about
     // the same), the sooner out.
     if (s_pos.reach > s_neg.reach + 0.1)
-      lane_sign_ = 1;
+      lane_sign = 1;
     else if (s_neg.reach > s_pos.reach + 0.1)
-      lane_sign_ = -1;
+      lane_sign = -1;
     else
-      lane_sign_ = s_neg.time < s_pos.time ? -1 : 1;
+      lane_sign = s_neg.time < s_pos.time ? -1 : 1;
   } else {
     // Kept once chosen: near the axis the side the robot is on flips with the walker's
     // estimated heading, and so would the robot. Given up only while the robot is still near
     // the axis, when its side is closed and the other is not (further out, going back across
     // is crossing in front of the walker).
-    const Side& mine = lane_sign_ > 0 ? s_pos : s_neg;
-    const Side& other = lane_sign_ > 0 ? s_neg : s_pos;
-    if (lane_sign_ * so < 0.15 && mine.room < 0.1 && other.room > 0.3 &&
+    const Side& mine = lane_sign > 0 ? s_pos : s_neg;
+    const Side& other = lane_sign > 0 ? s_neg : s_pos;
+    if (lane_sign * so < 0.15 && mine.room < 0.1 && other.room > 0.3 &&
         other.reach > mine.reach + 0.2)
-      lane_sign_ = -lane_sign_;
+      lane_sign = -lane_sign;
   }
-  const Side& goal = lane_sign_ > 0 ? s_pos : s_neg;
-  lane_side_ = lane_sign_ * perp;
-  const Eigen::Vector2d n = lane_sign_ * perp, nr = toRobot(n);
-  const double now_off = lane_sign_ * so;
+  const Side& goal = lane_sign > 0 ? s_pos : s_neg;
+  lane_side_ = lane_sign * perp;
+  const Eigen::Vector2d nr = toRobot(lane_side_);
+  const double now_off = lane_sign * so;
   side_ = nr.y() >= 0 ? DodgeSide::Left : DodgeSide::Right;
   double v = 0, dir = 0;
   bool steer = false;
@@ -430,7 +431,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   out.in_lane = lane;
   if (lane) out.walker_pos = walker_.pos, out.walker_vel = walker_.vel;
   if (lane) lane_t_ = now;
-  if (!lane && now - lane_t_ > 2.0) lane_sign_ = 0;
+  if (!lane && now - lane_t_ > 2.0) lane_side_.setZero();
   const double trigger = std::min(P.trigger_m + moving * P.approach_horizon_s, P.max_range_m - 0.3);
   const double toward = std::clamp(target_bearing, -0.6, 0.6);
   const double target_free = corridorFree(pts, toward, hw, P.max_range_m);

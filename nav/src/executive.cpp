@@ -817,11 +817,17 @@ struct Executive::Impl {
       }
     }
     // Walking people: keep out of their lanes (movers.h). In one: step out sideways (backing
-    // only slowly and with room behind); about to enter one: wait, turning is harmless.
-    if (s.movers.enabled && !dev.ranges.empty() && status == RunStatus::Running) {
+    // only slowly and with room behind); about to enter one: wait, turning is harmless. With
+    // lane keeping off, still the waiting, for walkers only (the tracker's walkers, not every
+    // mover; stepping out of a walker's lane is the avoider's): whatever drives does not take
+    // the robot into one. (A dodge that ended as the walker's track dropped out for a scan
+    // handed the robot back to the route, which crossed the lane 1 m in front of them.)
+    if (!dev.ranges.empty() && status == RunStatus::Running) {
       // It advises on the command that would drive otherwise, and may keep its yaw rate.
       const Command cur = arb.winner();
-      const auto adv = movers.advise(pose, cur.v, cur.w, s.exec.k_heading, s.exec.v_cruise);
+      const auto adv = s.movers.enabled
+                           ? movers.advise(pose, cur.v, cur.w, s.exec.k_heading, s.exec.v_cruise)
+                           : movers.holdShortOfWalkerLanes(pose, cur.v, cur.w);
       if (adv.active) {
         Command c = cur;
         if (!adv.in_lane) {
@@ -843,28 +849,6 @@ struct Executive::Impl {
           ++yields;
           event(event::YieldStart{adv.in_lane, adv.clearance_m, adv.mover.position,
                                   adv.mover.velocity, pose});
-        }
-      } else if (yielding) {
-        yielding = false;
-        event(event::YieldEnd{});
-      }
-    } else if (!dev.ranges.empty() && status == RunStatus::Running) {
-      // Lanes off: still, whatever drives does not take the robot into the lane of someone
-      // walking (the tracker's walkers, not every mover): it waits for them to pass. (A
-      // dodge that ended as the walker's track dropped out for a scan handed the robot back
-      // to the route, which crossed the lane 1 m in front of them.)
-      const Command cur = arb.winner();
-      const auto adv = movers.holdShortOfWalkerLanes(pose, cur.v, cur.w);
-      if (adv.active) {
-        Command c = cur;
-        c.v = 0;
-        c.turn = turnOf(c.w);
-        arb.propose(Behaviour::Yield, c);
-        if (!yielding) {
-          yielding = true;
-          ++yields;
-          event(event::YieldStart{false, adv.clearance_m, adv.mover.position, adv.mover.velocity,
-                                  pose});
         }
       } else if (yielding) {
         yielding = false;

@@ -87,7 +87,7 @@ void MoverTracker::update(const hw::Pose2D& robot, const hw::RangeScan& s,
   // Associate with the tracks' predictions, nearest pair first over all clusters and tracks,
   // then filter position and velocity (alpha-beta). (Taken cluster by cluster in beam order, a
   // one-beam fragment split off a person's edge came first, took their track 0.3 m off its
-  // prediction, and the person went on as a new track: 0.5 s without a walker.)
+  // prediction, and the person went on as a new track: 1.4 s without a walker.)
   const double t = s.stamp;
   std::vector<Eigen::Vector2d> centres;
   centres.reserve(clusters.size());

@@ -36,6 +36,20 @@ hw::RangeScan laser(const std::vector<Disc>& discs, std::vector<double> wall_y =
   }
   return s;
 }
+
+// One closed-loop tick at 10 Hz on `scan` (taken at `pose`): the avoider's command while it
+// manoeuvres, else route following towards `tb` at 0.3 m/s (capped by the clearance ahead),
+// driven for 0.1 s. Returns the avoider's output.
+AvoidOutput driveTick(ObstacleAvoider& a, hw::Pose2D& pose, const hw::RangeScan& scan, double tb,
+                      DodgeSide side, double t) {
+  const auto out = a.step({scan}, tb, side, pose.theta, 0.3, t);
+  const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
+  const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
+  pose.x += v * std::cos(pose.theta) * 0.1;
+  pose.y += v * std::sin(pose.theta) * 0.1;
+  pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+  return out;
+}
 }  // namespace
 
 TEST(Corridor, FreeLengthOfAStraightCorridor) {
@@ -243,13 +257,7 @@ TEST(Avoider, KeepsOutOfAWalkersLaneUntilTheyHavePassed) {
         const double tb = std::remainder(
             std::atan2(route.y() - pose.y, route.x() - pose.x) - pose.theta, 2 * M_PI);
         a.setPose(pose);
-        const auto scan = test::scanAt(pose, scene, {walker}, t);
-        const auto out = a.step({scan}, tb, DodgeSide::Right, pose.theta, 0.3, t);
-        const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
-        const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
-        pose.x += v * std::cos(pose.theta) * 0.1;
-        pose.y += v * std::sin(pose.theta) * 0.1;
-        pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+        driveTick(a, pose, test::scanAt(pose, scene, {walker}, t), tb, DodgeSide::Right, t);
         arrived = std::hypot(route.x() - pose.x, route.y() - pose.y) < 0.4;
       }
       EXPECT_GT(min_d, 0.45 + 0.05) << "lane " << lane_y << " start " << start_x;
@@ -294,13 +302,7 @@ CorridorMeet meetInCorridor(double half_width, double lane_y, double speed, doub
     const double tb = std::remainder(std::atan2(-pose.y, 1.5) - pose.theta, 2 * M_PI);
     a.setPose(pose);
     if (std::hypot(wx - pose.x, lane_y - pose.y) < 4.0) a.offerWalker({wx, lane_y}, {vx, 0.0});
-    const auto scan = test::scanAt(pose, walls, {walker}, t);
-    const auto out = a.step({scan}, tb, DodgeSide::Left, pose.theta, 0.3, t);
-    const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
-    const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
-    pose.x += v * std::cos(pose.theta) * 0.1;
-    pose.y += v * std::sin(pose.theta) * 0.1;
-    pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+    driveTick(a, pose, test::scanAt(pose, walls, {walker}, t), tb, DodgeSide::Left, t);
     r.arrived = pose.x > 12.0;
   }
   return r;
@@ -389,14 +391,9 @@ TEST(Avoider, DoesNotCrossInFrontOfAWalkerItCannotGetPastInTime) {
       if (wp.x() > pose.x) max_y = std::max(max_y, pose.y);
       a.setPose(pose);
       if (wp.x() > pose.x - 0.5) a.offerWalker(wp, {-0.4, 0.0});
-      const auto scan = test::scanAt(pose, wall, {{wp.x(), wp.y(), 0.25}}, t);
       const double tb = std::remainder(std::atan2(-pose.y, 1.5) - pose.theta, 2 * M_PI);
-      const auto out = a.step({scan}, tb, DodgeSide::Left, pose.theta, 0.3, t);
-      const double v = out.active ? out.v : a.capSpeed({scan}, 0.3 * std::max(0.0, std::cos(tb)));
-      const double w = std::clamp(out.active ? out.w : 1.5 * tb, -0.8, 0.8);
-      pose.x += v * std::cos(pose.theta) * 0.1;
-      pose.y += v * std::sin(pose.theta) * 0.1;
-      pose.theta = std::remainder(pose.theta + w * 0.1, 2 * M_PI);
+      driveTick(a, pose, test::scanAt(pose, wall, {{wp.x(), wp.y(), 0.25}}, t), tb, DodgeSide::Left,
+                t);
     }
     if (start_x < 3.0) {
       // Across takes ~6 s, they arrive in 5.1 s: without this rule it went and was walked

@@ -4,6 +4,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <functional>
 
 #include "scan_sim.h"
 #include "sketchnav/core/error.h"
@@ -16,9 +17,12 @@ using namespace sketchnav::nav::test;
 
 namespace {
 // The robot at `robot` watches the empty room (the floor is seen free), then a person walks
-// from `from` with `vel` for `secs` at 10 Hz.
+// from `from` with `vel` for `secs` at 10 Hz; `each` (when given) sees the tracker after every
+// scan, with the scan's time and the person's position.
+using EachScan = std::function<void(double, const Eigen::Vector2d&, const MoverTracker&)>;
 MoverTracker watch(LocalPlanner& grid, const hw::Pose2D& robot, Eigen::Vector2d from,
-                   Eigen::Vector2d vel, double secs, bool enabled = true) {
+                   Eigen::Vector2d vel, double secs, bool enabled = true,
+                   const EachScan& each = {}) {
   auto boxes = room();
   for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
   MoverParams on;
@@ -31,6 +35,7 @@ MoverTracker watch(LocalPlanner& grid, const hw::Pose2D& robot, Eigen::Vector2d 
     const auto s = scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t);
     tr.update(robot, s, before);
     grid.insert(robot, s);
+    if (each) each(t, p, tr);
   }
   return tr;
 }
@@ -52,24 +57,16 @@ TEST(Movers, AWalkerStaysOneTrackWhenABeamSplitsOffTheirEdge) {
   // it used to steal their track, and they were no walker for 1.4 s; once a walker, they stay
   // one.
   LocalPlanner grid;
-  const hw::Pose2D robot{0, 0, 0};
-  auto boxes = room();
-  for (int i = 0; i < 5; ++i) grid.insert(robot, scanAt(robot, boxes, {}, 0.1 * i));
-  MoverTracker tr(MoverParams{});
-  const LocalPlanner before = grid.snapshot();
   bool walker = false;
-  for (double t = 0.5; t <= 4.5 + 1e-9; t += 0.1) {
-    const Eigen::Vector2d p(3.0, 2.0 - 0.4 * (t - 0.5));
-    const auto s = scanAt(robot, boxes, {{p.x(), p.y(), 0.25}}, t);
-    tr.update(robot, s, before);
-    grid.insert(robot, s);
-    const auto w = tr.walkers();
-    if (walker) {
-      ASSERT_EQ(w.size(), 1u) << "t=" << t << " y=" << p.y();
-      EXPECT_NEAR(w[0].position.y(), p.y(), 0.15) << "t=" << t;
-    }
-    walker = walker || !w.empty();
-  }
+  watch(grid, {0, 0, 0}, {3.0, 2.0}, {0.0, -0.4}, 4.0, false,
+        [&](double t, const Eigen::Vector2d& p, const MoverTracker& tr) {
+          const auto w = tr.walkers();
+          if (walker) {
+            ASSERT_EQ(w.size(), 1u) << "t=" << t << " y=" << p.y();
+            EXPECT_NEAR(w[0].position.y(), p.y(), 0.15) << "t=" << t;
+          }
+          walker = walker || !w.empty();
+        });
   EXPECT_TRUE(walker);
 }
 
@@ -161,7 +158,7 @@ TEST(Movers, WithLanesOffTheRobotStillHoldsShortOfAWalkersLane) {
   EXPECT_TRUE(hold.active);
   EXPECT_EQ(hold.v, 0.0);
   EXPECT_EQ(hold.w, 0.1);
-  EXPECT_FALSE(tr.holdShortOfWalkerLanes({1.0, 0.0, 0.0}, 0.3, 0.0).active);  // not that soon
+  EXPECT_FALSE(tr.holdShortOfWalkerLanes({1.0, 0.0, 0.0}, 0.3, 0.0).active);   // not that soon
   EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.0, 0.0, M_PI}, 0.3, 0.0).active);  // driving off
   EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.8, 0.0, 0.0}, 0.3, 0.0).active);   // in it already
   EXPECT_FALSE(tr.holdShortOfWalkerLanes({2.0, 0.0, 0.0}, 0.0, 0.5).active);   // not driving

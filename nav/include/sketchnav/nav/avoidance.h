@@ -189,9 +189,10 @@ class ObstacleAvoider {
     Eigen::Vector2d pos{0, 0}, vel{0, 0};
     double t = 0;
   } walker_;
-  int lane_sign_ = 0;  // side of the walker's axis the robot steps out to (+-1 x its left)
-  Eigen::Vector2d lane_side_{0, 0};  // that side as a direction in the odometry frame
-  double lane_t_ = -1e300;           // when a lane last covered the robot
+  // The side of the walker's axis the robot steps out to, a unit direction in the odometry
+  // frame (zero: none chosen).
+  Eigen::Vector2d lane_side_{0, 0};
+  double lane_t_ = -1e300;  // when a lane last covered the robot
   void followWalker(const std::vector<hw::RangeScan>& scans, double stamp, bool acquire);
   /// The unit normal from the walker's lane axis towards the robot, and the robot's offset
   /// from the axis [m], when the lane covers the robot; false otherwise.
