@@ -266,6 +266,7 @@ int makeBenchSequences(const Args& args, GlobalOptions& g) {
   o.hfov_deg = args.getDouble("hfov");
   if (!(o.hfov_deg > 1 && o.hfov_deg < 179)) throw InputError("--hfov must be in (1, 179) degrees");
   applyConfig(o.servo, g.config, "servo");
+  o.servo.setCamera(cameraMountFrom(g.config));
   o.servo.validate();
   const auto names = bench::makeSequences(o);
   if (g.json)
@@ -346,6 +347,7 @@ int runEval(const Args& args, GlobalOptions& g) {
   const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
   servo::TurnLawParams tp;
   applyConfig(tp, g.config, "servo");
+  tp.setCamera(cameraMountFrom(g.config));
   tp.validate();
   nav::LandmarkPerception perception(model, pp);
   servo::TurnLaw law(tp);
@@ -531,6 +533,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
   const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
   servo::TurnLawParams tp;
   applyConfig(tp, g.config, "servo");
+  tp.setCamera(cameraMountFrom(g.config));
   tp.validate();
   // A camera URI's driver settings (sim.*, camera.*) are applied when it is opened.
   g.config.requireAllUsedExcept({"sim.", "camera."});

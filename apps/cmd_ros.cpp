@@ -229,14 +229,14 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     std::string camera_frame;
     if (rp.camera_mount_from_tf) {
       camera_frame = ros::imageFrame(rp.image_topic, rp.wait_s, rp.image_transport);
-      ros::CameraMount m;
+      CameraMount m;
       if (!camera_frame.empty() && ros::lookupCameraMount(rp.base_frame, camera_frame, 2.0, m)) {
-        if (!c.has("servo.camera_x_m")) c.set("servo.camera_x_m", m.x);
-        if (!c.has("servo.camera_z_m")) c.set("servo.camera_z_m", m.z);
-        if (!c.has("nav.perception.camera_yaw")) c.set("nav.perception.camera_yaw", m.yaw);
-        if (!c.has("nav.perception.camera_pitch")) c.set("nav.perception.camera_pitch", m.pitch);
+        if (!c.has("robot.camera.x_m")) c.set("robot.camera.x_m", m.x_m);
+        if (!c.has("robot.camera.z_m")) c.set("robot.camera.z_m", m.z_m);
+        if (!c.has("robot.camera.yaw")) c.set("robot.camera.yaw", m.yaw);
+        if (!c.has("robot.camera.pitch")) c.set("robot.camera.pitch", m.pitch);
         char b[160];
-        std::snprintf(b, sizeof b, "x %.3f m, z %.3f m, yaw %.1f deg, pitch %.1f deg", m.x, m.z,
+        std::snprintf(b, sizeof b, "x %.3f m, z %.3f m, yaw %.1f deg, pitch %.1f deg", m.x_m, m.z_m,
                       m.yaw * 180 / M_PI, m.pitch * 180 / M_PI);
         log::info("ros", "camera mount from tf", {{"frame", camera_frame}, {"mount", b}});
       } else {

@@ -3,7 +3,9 @@
 #include <cstdint>
 #include <fstream>
 
+#include "sketchnav/core/camera_mount.h"
 #include "sketchnav/core/config.h"
+#include "sketchnav/core/error.h"
 #include "test_data.h"
 
 using namespace sketchnav;
@@ -263,4 +265,35 @@ TEST(Config, ClosestKeyIsTheNearestByEditDistance) {
   EXPECT_EQ(closestKey("nav.max_v", known), "nav.max_w");
   EXPECT_EQ(closestKey("servo.maxw", known), "servo.max_w");
   EXPECT_EQ(closestKey("anything", {}), "");
+}
+
+TEST(CameraMount, OneSettingGroupAndTheOldNamesPointToIt) {
+  Config c;
+  c.set("robot.camera.x_m", 0.2);
+  c.set("robot.camera.pitch", 0.1);
+  const CameraMount m = cameraMountFrom(c);
+  EXPECT_DOUBLE_EQ(m.x_m, 0.2);
+  EXPECT_DOUBLE_EQ(m.z_m, CameraMount{}.z_m);
+  EXPECT_DOUBLE_EQ(m.pitch, 0.1);
+  EXPECT_NO_THROW(c.requireAllUsed());
+  // The quantity had three homes (servo.*, nav.perception.*, the world file); a setting under an
+  // old name is an error that names the new one, not a value silently ignored.
+  for (const auto& [old_key, new_key] : cameraMountRenames()) {
+    Config o;
+    o.set(old_key, 0.1);
+    try {
+      cameraMountFrom(o);
+      FAIL() << old_key << " accepted";
+    } catch (const InputError& e) {
+      EXPECT_NE(std::string(e.what()).find(new_key), std::string::npos) << e.what();
+    }
+  }
+  Config bad;
+  bad.set("robot.camera.pitch", 2.0);
+  try {
+    cameraMountFrom(bad);
+    FAIL() << "a pitch of 2 rad accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("robot.camera.pitch"), std::string::npos) << e.what();
+  }
 }

@@ -57,6 +57,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.movers, c, "nav.movers");
   applyConfig(s.goal_door, c, "nav.goal_door");
   applyConfig(s.servo, c, "servo");
+  s.servo.setCamera(cameraMountFrom(c));
   return s;
 }
 

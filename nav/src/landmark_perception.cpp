@@ -64,6 +64,7 @@ void PerceptionParams::validate() const {
 PerceptionParams perceptionParamsFrom(const Config& config) {
   PerceptionParams p;
   applyConfig(p, config, "nav.perception");
+  p.setCamera(cameraMountFrom(config));
   applyConfig(p.track, config, "nav.perception.track");
   applyConfig(p.recognition, config, "landmarks.recognition");
   p.objectness = landmarks::objectnessParamsFrom(config);

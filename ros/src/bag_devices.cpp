@@ -195,10 +195,10 @@ class BagRecorder final : public drivers::Recorder {
     write(kRunInfoTopic, ::ros::TIME_MIN, m);
     // The camera's mount on tf_static as `ros sim` publishes it (base_link -> camera_optical,
     // REP 103 optical axes), for ROS tools and a `ros nav` replay reading it from tf.
-    const double x = settings.value("servo.camera_x_m", 0.0),
-                 z = settings.value("servo.camera_z_m", 0.0),
-                 yaw = settings.value("nav.perception.camera_yaw", 0.0),
-                 pitch = settings.value("nav.perception.camera_pitch", 0.0);
+    const double x = settings.value("robot.camera.x_m", 0.0),
+                 z = settings.value("robot.camera.z_m", 0.0),
+                 yaw = settings.value("robot.camera.yaw", 0.0),
+                 pitch = settings.value("robot.camera.pitch", 0.0);
     // Body axes (x ahead, y left, z up) turned by yaw then tilted up by pitch; the optical
     // frame's x right, y down, z along the view.
     tf2::Matrix3x3 body;

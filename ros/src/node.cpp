@@ -432,7 +432,7 @@ bool waitForTime(double timeout_s) {
 }
 
 bool lookupCameraMount(const std::string& base_frame, const std::string& camera_frame,
-                       double timeout_s, CameraMount& out) {
+                       double timeout_s, sketchnav::CameraMount& out) {
   State& s = state();
   if (!s.tf || camera_frame.empty()) return false;
   geometry_msgs::TransformStamped t;
@@ -450,12 +450,10 @@ bool lookupCameraMount(const std::string& base_frame, const std::string& camera_
   const tf2::Matrix3x3 R(tf2::Quaternion(q.x, q.y, q.z, q.w));
   // The optical axis (z of an optical frame, REP 103) in the base frame.
   const tf2::Vector3 d = R * tf2::Vector3(0, 0, 1);
-  out.x = t.transform.translation.x;
-  out.y = t.transform.translation.y;
-  out.z = t.transform.translation.z;
+  out.x_m = t.transform.translation.x;
+  out.z_m = t.transform.translation.z;
   out.yaw = std::atan2(d.y(), d.x());
   out.pitch = std::atan2(d.z(), std::hypot(d.x(), d.y()));
-  out.frame = camera_frame;
   return true;
 }
 

@@ -883,7 +883,7 @@ TEST(RosBag, RecordedRunReplaysOnItsOwnTimes) {
   sketchnav::ros::registerBagDriver();
   {
     auto rec = sketchnav::drivers::openRecorder(file);
-    rec->addRunInfo({{"servo.camera_x_m", 0.1}, {"nav.perception.camera_pitch", 0.2}});
+    rec->addRunInfo({{"robot.camera.x_m", 0.1}, {"robot.camera.pitch", 0.2}});
     for (int k = 0; k <= 4; ++k) {
       const double t = 0.05 * k;
       hw::Odometry o;
@@ -913,7 +913,7 @@ TEST(RosBag, RecordedRunReplaysOnItsOwnTimes) {
     }
   }
   const auto info = sketchnav::drivers::readRunInfo(file);
-  EXPECT_DOUBLE_EQ(info.value("servo.camera_x_m", 0.0), 0.1);
+  EXPECT_DOUBLE_EQ(info.value("robot.camera.x_m", 0.0), 0.1);
 
   auto& reg = hw::Registry::instance();
   hw::DeviceContext ctx;

@@ -306,6 +306,7 @@ RunSettings runSettingsFrom(const Config& c) {
   RunSettings r;
   applyConfig(r.route, c, "route");
   applyConfig(r.train, c, "landmarks.train");
+  r.camera = cameraMountFrom(c);
   r.nav = nav::navSettingsFrom(c);
   r.perception = nav::perceptionParamsFrom(c);
   applyConfig(r.sim, c, "sim");
@@ -314,6 +315,7 @@ RunSettings runSettingsFrom(const Config& c) {
 
 Json runSettingsJson(const RunSettings& r, bool with_sim) {
   Json j = Json::object();
+  j["robot"]["camera"] = paramsToJson(r.camera);
   j["route"] = paramsToJson(r.route);
   j["landmarks"]["train"] = paramsToJson(r.train);
   j["landmarks"]["recognition"] = paramsToJson(r.perception.recognition);
@@ -491,38 +493,45 @@ Json runNavigation(const RunOptions& o) {
   if (simr) {
     // The simulated robot's geometry, unless the user overrides it.
     const auto& w = simr->world();
-    if (!o.config.has("servo.camera_x_m")) settings.servo.camera_x_m = w.camera.x;
-    if (!o.config.has("servo.camera_z_m")) settings.servo.camera_z_m = w.camera.z;
+    if (!o.config.has("robot.camera.x_m")) rs.camera.x_m = w.camera.x;
+    if (!o.config.has("robot.camera.z_m")) rs.camera.z_m = w.camera.z;
+    if (!o.config.has("robot.camera.yaw")) rs.camera.yaw = w.camera.yaw;
+    if (!o.config.has("robot.camera.pitch")) rs.camera.pitch = w.camera.pitch;
     if (!o.config.has("nav.avoid.robot_radius_m")) settings.avoid.robot_radius_m = w.robot.radius;
     if (!o.config.has("nav.camera_period_s") && simr->params().camera_hz > 0)
       settings.exec.camera_period_s = 1.0 / simr->params().camera_hz;
-    if (!o.config.has("nav.perception.camera_yaw")) pp.camera_yaw = w.camera.yaw;
-    if (!o.config.has("nav.perception.camera_pitch")) pp.camera_pitch = w.camera.pitch;
   }
   if (replay) {
     // The robot's geometry the recorded run used (RunInfo), unless the user overrides it: a
     // replay with another camera mount would servo differently on the same frames.
+    // Recordings made before the mount was one setting group name it the old way.
     const Json info = drivers::readRunInfo(o.replay);
-    const auto take = [&](const char* key, double& v) {
-      if (o.config.has(key) || !info.contains(key)) return;
-      if (!info[key].is_number())
-        throw InputError("--replay " + o.replay + ": run info '" + key + "' is not a number");
-      v = info[key].get<double>();
+    const auto take = [&](const std::string& key, double& v) {
+      std::string k = key;
+      for (const auto& [old_key, new_key] : cameraMountRenames())
+        if (new_key == key && !info.contains(key) && info.contains(old_key)) k = old_key;
+      if (o.config.has(key) || !info.contains(k)) return;
+      if (!info[k].is_number())
+        throw InputError("--replay " + o.replay + ": run info '" + k + "' is not a number");
+      v = info[k].get<double>();
     };
-    take("servo.camera_x_m", settings.servo.camera_x_m);
-    take("servo.camera_z_m", settings.servo.camera_z_m);
+    take("robot.camera.x_m", rs.camera.x_m);
+    take("robot.camera.z_m", rs.camera.z_m);
     take("nav.avoid.robot_radius_m", settings.avoid.robot_radius_m);
     take("nav.camera_period_s", settings.exec.camera_period_s);
-    take("nav.perception.camera_yaw", pp.camera_yaw);
-    take("nav.perception.camera_pitch", pp.camera_pitch);
+    take("robot.camera.yaw", rs.camera.yaw);
+    take("robot.camera.pitch", rs.camera.pitch);
   }
+  rs.camera.validate();
+  settings.servo.setCamera(rs.camera);
+  pp.setCamera(rs.camera);
   if (rec)
-    rec->addRunInfo({{"servo.camera_x_m", settings.servo.camera_x_m},
-                     {"servo.camera_z_m", settings.servo.camera_z_m},
+    rec->addRunInfo({{"robot.camera.x_m", rs.camera.x_m},
+                     {"robot.camera.z_m", rs.camera.z_m},
                      {"nav.avoid.robot_radius_m", settings.avoid.robot_radius_m},
                      {"nav.camera_period_s", settings.exec.camera_period_s},
-                     {"nav.perception.camera_yaw", pp.camera_yaw},
-                     {"nav.perception.camera_pitch", pp.camera_pitch}});
+                     {"robot.camera.yaw", rs.camera.yaw},
+                     {"robot.camera.pitch", rs.camera.pitch}});
   if (o.max_time_s > 0) settings.exec.max_time_s = o.max_time_s;
   settings.exec.validate();
   settings.servo.validate();

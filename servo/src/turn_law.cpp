@@ -34,9 +34,9 @@ void TurnLawParams::validate() const {
   require(std::isfinite(max_w) && max_w > 0, "servo.max_w", "must be > 0");
   require(std::isfinite(dead_band) && dead_band >= 0 && dead_band < 1, "servo.dead_band",
           "must be in [0, 1)");
-  require(std::isfinite(camera_x_m) && std::abs(camera_x_m) < 5, "servo.camera_x_m",
+  require(std::isfinite(camera_x_m) && std::abs(camera_x_m) < 5, "robot.camera.x_m",
           "must be a finite offset below 5 m");
-  require(std::isfinite(camera_z_m) && std::abs(camera_z_m) < 5, "servo.camera_z_m",
+  require(std::isfinite(camera_z_m) && std::abs(camera_z_m) < 5, "robot.camera.z_m",
           "must be a finite offset below 5 m");
   require(std::isfinite(default_depth_m) && default_depth_m > 0.05, "servo.default_depth_m",
           "must be > 0.05 m");

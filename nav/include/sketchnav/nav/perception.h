@@ -11,6 +11,7 @@
 
 #include <opencv2/core/types.hpp>
 
+#include "sketchnav/core/camera_mount.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/types.h"
 #include "sketchnav/landmarks/objectness.h"
@@ -105,9 +106,11 @@ struct PerceptionParams {
   double distinct_min_fraction = 0.3;
   bool paper_offset = true;  // feature from the paper's median (x_t - x_d) over inliers;
                              // false: the homography-projected object centre
-  double camera_yaw = 0;     // [rad] camera pan on the robot (bearing = yaw - atan(x))
-  double camera_pitch = 0;   // [rad] camera tilt, up positive (for Detection::elevation)
-  double merge_iou = 0.3;    // detections of a class overlapping more are one landmark
+  // The camera's pan and tilt, from the camera mount (the "robot.camera.*" settings,
+  // CameraMount in core/camera_mount.h): not settings of their own.
+  double camera_yaw = 0;    // [rad] camera pan on the robot (bearing = yaw - atan(x))
+  double camera_pitch = 0;  // [rad] camera tilt, up positive (for Detection::elevation)
+  double merge_iou = 0.3;   // detections of a class overlapping more are one landmark
   // SIFT settings for camera frames (the model's photo settings are 400 px / 500 keypoints).
   // Larger frames find small, distant landmarks more often but bring back false reports of
   // sibling products and cost time; raise both for small or distant landmarks. The evidence:
@@ -181,8 +184,6 @@ struct PerceptionParams {
     b("max_photos", max_photos);
     b("distinct_min_fraction", distinct_min_fraction);
     b("paper_offset", paper_offset);
-    b("camera_yaw", camera_yaw);
-    b("camera_pitch", camera_pitch);
     b("merge_iou", merge_iou);
     b("frame_max_side", frame_max_side);
     b("frame_max_features", frame_max_features);
@@ -206,6 +207,11 @@ struct PerceptionParams {
     b("threads", threads);
   }
   void validate() const;  // InputError "nav.perception.<field> = ...: ..."
+  /// Takes the camera's pan and tilt from the mount.
+  void setCamera(const CameraMount& m) {
+    camera_yaw = m.yaw;
+    camera_pitch = m.pitch;
+  }
 };
 
 /// The perception settings of a run or replay from `config`: "nav.perception.*", with its

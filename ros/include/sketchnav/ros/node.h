@@ -24,6 +24,7 @@
 #include <string>
 #include <vector>
 
+#include "sketchnav/core/camera_mount.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/clock.h"
 
@@ -53,8 +54,8 @@ struct RosParams {
   std::string odom_source = "topic";  // "topic": nav_msgs/Odometry on odom_topic; "tf": the
                                       // transform odom_frame -> base_frame (REP 105)
   std::string odom_frame = "odom";    // the odometry frame (tf source; pose, route, markers)
-  bool camera_mount_from_tf = true;   // servo.camera_x_m/z_m, nav.perception.camera_yaw/pitch
-                                      // from tf base_frame -> the image's frame, unless set
+  bool camera_mount_from_tf = true;   // robot.camera.* (the camera mount) from tf
+                                      // base_frame -> the image's frame, unless set
   template <class B>
   void bind(B& b) {
     b("stale_timeout_s", stale_timeout_s);
@@ -131,16 +132,11 @@ Json latencySummary();
 /// Registers the ros:// camera, base and range drivers with hw::Registry. Idempotent.
 void registerDrivers();
 
-/// Where tf puts a camera's optical frame in the base frame.
-struct CameraMount {
-  double x = 0, y = 0, z = 0;  // [m]
-  double yaw = 0;              // [rad] pan, CCW
-  double pitch = 0;            // [rad] tilt, up positive
-  std::string frame;
-};
-/// Looks up tf base_frame -> camera_frame (waiting up to timeout_s wall). False when absent.
+/// Looks up tf base_frame -> camera_frame (waiting up to timeout_s wall) as the camera mount
+/// (the optical axis's pan and tilt, the optical centre ahead of and above the base frame's
+/// origin; a sideways offset is not part of the mount). False when absent.
 bool lookupCameraMount(const std::string& base_frame, const std::string& camera_frame,
-                       double timeout_s, CameraMount& out);
+                       double timeout_s, sketchnav::CameraMount& out);
 /// The frame_id of the next image on `topic` (waiting up to timeout_s wall); "" on timeout.
 /// `transport` "compressed" reads sensor_msgs/CompressedImage on `topic`/compressed.
 std::string imageFrame(const std::string& topic, double timeout_s,

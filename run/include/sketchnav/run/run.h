@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "sketchnav/core/camera_mount.h"
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/devices.h"
 #include "sketchnav/landmarks/model.h"
@@ -58,6 +59,7 @@ struct RunOptions {
 /// Every setting a run uses, over the defaults, validated. Device drivers' settings
 /// ("base.dani.*", "camera.aravis.*", "camera.folder.*") are applied when the device is opened.
 struct RunSettings {
+  CameraMount camera;                // "robot.camera.*" (fed to nav.servo and perception)
   mapsketch::RouteParams route;      // "route.*"
   landmarks::ModelParams train;      // "landmarks.train.*" (when the model is trained)
   nav::NavSettings nav;              // "nav.*" (with its sections) and "servo.*"

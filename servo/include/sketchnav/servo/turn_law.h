@@ -19,16 +19,20 @@
 #include <string>
 #include <vector>
 
+#include "sketchnav/core/camera_mount.h"
+
 namespace sketchnav::servo {
 
 enum class Turn { Left, Straight, Right };
 const char* toString(Turn t);
 
 struct TurnLawParams {
-  double lambda = 0.8;           // [1/s] turn-radius gain: larger = sharper turns for an offset
-  double v_forward = 0.30;       // [m/s] forward speed kept while servoing
-  double max_w = 0.6;            // [rad/s] yaw-rate saturation (also bounds the turn radius)
-  double dead_band = 0.02;       // [normalised] |x_t - x_d| below this -> Straight, w = 0
+  double lambda = 0.8;      // [1/s] turn-radius gain: larger = sharper turns for an offset
+  double v_forward = 0.30;  // [m/s] forward speed kept while servoing
+  double max_w = 0.6;       // [rad/s] yaw-rate saturation (also bounds the turn radius)
+  double dead_band = 0.02;  // [normalised] |x_t - x_d| below this -> Straight, w = 0
+  // The camera's position, from the camera mount (the "robot.camera.*" settings, CameraMount
+  // in core/camera_mount.h): not settings of their own.
   double camera_x_m = 0.13;      // [m] camera optical centre ahead of the wheel axis
   double camera_z_m = 0.30;      // [m] camera height above the wheel axis
   double default_depth_m = 2.0;  // [m] landmark depth when no range measurement is given
@@ -39,13 +43,16 @@ struct TurnLawParams {
     b("v_forward", v_forward);
     b("max_w", max_w);
     b("dead_band", dead_band);
-    b("camera_x_m", camera_x_m);
-    b("camera_z_m", camera_z_m);
     b("default_depth_m", default_depth_m);
     b("feed_forward", feed_forward);
   }
   /// Throws InputError naming the field ("servo.lambda = -1: must be > 0").
   void validate() const;
+  /// Takes the camera's position from the mount.
+  void setCamera(const CameraMount& m) {
+    camera_x_m = m.x_m;
+    camera_z_m = m.z_m;
+  }
 };
 
 struct TurnCommand {
