@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <deque>
 
 #include <Eigen/Core>
 
@@ -52,6 +53,10 @@ void AvoidParams::validate() const {
   require(lane_escape_deg >= 0 && lane_escape_deg <= 85, "nav.avoid.lane_escape_deg",
           "must be in [0, 85]");
   require(max_turn_rate > 0, "nav.avoid.max_turn_rate", "must be > 0 rad/s");
+  require(lane_reverse_speed >= 0 && lane_reverse_speed <= 1.0, "nav.avoid.lane_reverse_speed",
+          "must be in [0, 1] m/s (0 = no backing out of a lane)");
+  require(rear_memory_s >= 0 && rear_memory_s <= 30, "nav.avoid.rear_memory_s",
+          "must be in [0, 30] s");
 }
 
 std::vector<std::pair<double, double>> scanPoints(const std::vector<hw::RangeScan>& scans,
@@ -89,6 +94,13 @@ double corridorFree(const std::vector<std::pair<double, double>>& pts, double di
 
 struct ObstacleAvoider::Impl {
   mrpt::nav::CHolonomicND nd;
+  // Laser scans of the last rear_memory_s with the robot's pose when each came in (newest
+  // last): what the floor behind the robot, outside the laser's view now, looked like.
+  struct Seen {
+    hw::Pose2D pose;
+    hw::RangeScan scan;
+  };
+  std::deque<Seen> seen;
 };
 
 ObstacleAvoider::ObstacleAvoider(AvoidParams params) : params_(params) {
@@ -171,6 +183,53 @@ void ObstacleAvoider::offerWalker(const Eigen::Vector2d& position,
   if (!inLane(n, off)) walker_ = keep;
 }
 
+bool ObstacleAvoider::sweptSeenFree(double direction, double len) const {
+  const auto& seen = impl_->seen;
+  if (seen.empty() || !have_pose_) return false;
+  const double R = params_.robot_radius_m + 0.02;
+  const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
+  const double dc = std::cos(direction), ds = std::sin(direction);
+  // Samples over the swept disc: its centre line and both edges every 0.1 m, and the far end's
+  // rim; a person or a chair leg is wider than the spacing.
+  for (double d = 0.1; d <= len + R + 1e-9; d += 0.1) {
+    for (const double l : {-R, 0.0, R}) {
+      if (d > len && l != 0.0) continue;
+      const double px = d * dc - l * ds, py = d * ds + l * dc;  // robot frame
+      const double qx = pose_.x + c * px - sn * py, qy = pose_.y + sn * px + c * py;
+      bool decided = false;
+      for (auto it = seen.rbegin(); it != seen.rend() && !decided; ++it) {
+        const auto& sc = it->scan;
+        const size_t n = std::min(sc.angles.size(), sc.ranges.size());
+        if (n < 2) continue;
+        // The sample in this scan's sensor frame.
+        const double th = it->pose.theta + sc.mount.theta;
+        const double mx = it->pose.x + std::cos(it->pose.theta) * sc.mount.x -
+                          std::sin(it->pose.theta) * sc.mount.y;
+        const double my = it->pose.y + std::sin(it->pose.theta) * sc.mount.x +
+                          std::cos(it->pose.theta) * sc.mount.y;
+        const double ex = qx - mx, ey = qy - my;
+        const double r = std::hypot(ex, ey);
+        const double b = wrapAngle(std::atan2(ey, ex) - th);
+        const double a0 = sc.angles.front(), a1 = sc.angles[n - 1];
+        if (b < std::min(a0, a1) || b > std::max(a0, a1)) continue;  // outside its view
+        const double step = (a1 - a0) / static_cast<double>(n - 1);
+        const auto k = static_cast<size_t>(
+            std::clamp(std::lround((b - a0) / step), 0L, static_cast<long>(n) - 1));
+        const double rb = std::isfinite(sc.ranges[k]) ? std::min<double>(sc.ranges[k], sc.max_range)
+                                                      : sc.max_range;
+        if (rb > r + 0.05) {
+          decided = true;  // the beam went past it: free
+        } else if (rb > r - 0.15) {
+          return false;  // something there
+        }
+        // else hidden behind something nearer: an older scan may have seen it
+      }
+      if (!decided) return false;  // never seen: not known free
+    }
+  }
+  return true;
+}
+
 bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
   const auto& P = params_;
   const double speed = walker_.vel.norm();
@@ -232,6 +291,11 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   const double steep = std::sin(P.lane_escape_deg * M_PI / 180);
   // Signed offset of the robot from the axis along perp.
   const double so = lane_n.dot(perp) >= 0 ? lane_off : -lane_off;
+  // When the walker's body reaches the robot's along their line, at their speed.
+  const double walker_speed = walker_.vel.norm();
+  const double arrive_s = std::max(0.0, (Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos).dot(u) -
+                                            (P.robot_radius_m + P.person_radius_m)) /
+                          std::max(walker_speed, 0.05);
   // The room a side leaves (along its normal, the robot's disc kept min_clearance_m off what
   // the laser sees), the offset it allows (capped at `clear`) and the time to get there (turn
   // + sideways drive).
@@ -246,20 +310,22 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
         std::max(0.0, corridorFree(pts, a, P.robot_radius_m, P.max_range_m) - P.min_clearance_m);
     const double now_off = sign * so;
     r.reach = std::min(clear, now_off + r.room);
-    const double turn = std::max(0.0, std::abs(a) - (M_PI / 2 - P.lane_escape_deg * M_PI / 180));
-    r.time = turn / P.max_turn_rate +
-             std::max(0.0, r.reach - now_off) / (std::max(v_nominal, 0.05) * steep);
+    const double slack = M_PI / 2 - P.lane_escape_deg * M_PI / 180;
+    const double turn = std::max(0.0, std::abs(a) - slack);
+    const double dist = std::max(0.0, r.reach - now_off);
+    r.time = turn / P.max_turn_rate + dist / (std::max(v_nominal, 0.05) * steep);
+    // Or backwards, where driving out forwards means turning on the spot first (below).
+    const double back_turn = std::max(0.0, std::abs(wrapAngle(a - M_PI)) - slack);
+    if (P.lane_reverse_speed > 0 && turn > 1.0 && back_turn < turn && arrive_s > 0.3 &&
+        now_off >= 0 && sweptSeenFree(a, dist + P.min_clearance_m))
+      r.time =
+          std::min(r.time, back_turn / P.max_turn_rate + dist / (P.lane_reverse_speed * steep));
     return r;
   };
   const Side s_pos = side(1), s_neg = side(-1);
   const int own = so >= 0 ? 1 : -1;
   const Side& own_side = own > 0 ? s_pos : s_neg;
   const Side& across = own > 0 ? s_neg : s_pos;
-  // When the walker's body reaches the robot's along their line, at their speed.
-  const double walker_speed = walker_.vel.norm();
-  const double arrive_s = std::max(0.0, (Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos).dot(u) -
-                                            (P.robot_radius_m + P.person_radius_m)) /
-                          std::max(walker_speed, 0.05);
   // The side kept (lane_side_) is a direction on the floor, not the walker's left or right:
   // when their heading turns round (a walker who turns back, or is first estimated walking
   // the wrong way), "their left" is the other side, and a sign kept would send the robot
@@ -274,9 +340,15 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
     // a collision.
     lane_sign = own;
   } else if (lane_sign == 0) {
-    // Near the axis: the side that leaves the larger gap; where both leave the lane (or about
-    // the same), the sooner out.
-    if (s_pos.reach > s_neg.reach + 0.1)
+    // Near the axis: the side that gets there before the walker does, when only one does (a
+    // robot facing a wall half a metre away chose the open side behind it for its larger gap,
+    // 6 s of turning and driving with the walker 4.5 s away, and was walked into: generated
+    // mixed-7312); else the side that leaves the larger gap; where both leave the lane (or
+    // about the same), the sooner out.
+    const bool pos_in_time = s_pos.time < arrive_s, neg_in_time = s_neg.time < arrive_s;
+    if (pos_in_time != neg_in_time)
+      lane_sign = pos_in_time ? 1 : -1;
+    else if (s_pos.reach > s_neg.reach + 0.1)
       lane_sign = 1;
     else if (s_neg.reach > s_pos.reach + 0.1)
       lane_sign = -1;
@@ -303,17 +375,56 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   const double togo = std::min(goal.reach, clear) - now_off;
   if (togo > 0.03 && goal.room > 0.03) {
     // Of the directions that leave steeply enough and have room for the next few centimetres,
-    // the quickest out: the turn to it plus the drive sideways; ties to the route's.
+    // the quickest out: the turn to it plus the drive sideways; ties to the route's. A
+    // direction behind the robot may also be taken backwards (lane_reverse_speed): turning
+    // round first stands the robot in the lane for seconds (a turn of 150 degrees is 3.3 s
+    // at 0.8 rad/s) while backing gains sideways at once.
     double best = 1e300, best_free = 0;
+    bool backwards = false;
+    const double v_back = P.lane_reverse_speed;
     for (int i = -35; i <= 36; ++i) {
       const double a = i * 5 * M_PI / 180;
       const double away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
       if (away < steep - 1e-9) continue;
       const double free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
       if (free < P.min_clearance_m + 0.02) continue;
-      const double t = std::abs(a) / P.max_turn_rate + togo / (std::max(v_nominal, 0.05) * away) +
-                       0.01 * std::abs(wrapAngle(a - target_bearing));
+      const double tie = 0.01 * std::abs(wrapAngle(a - target_bearing));
+      const double t =
+          std::abs(a) / P.max_turn_rate + togo / (std::max(v_nominal, 0.05) * away) + tie;
       if (t < best) best = t, dir = a, best_free = free, steer = true;
+    }
+    // Backwards only where every forward way out means turning on the spot first (more than
+    // 1 rad): elsewhere the two would take turns from one scan to the next as the walker passes.
+    // And only while the walker is still coming: once they are level with the robot their
+    // heading, and so the way out, is estimated from the side of them in view and swings.
+    // And never across the walker's axis: backing is for getting further out on the side the
+    // robot is on (backing across it, with two walkers about, took a robot 0.1 m towards
+    // their line in generated hall-7310).
+    if (v_back > 0 && (!steer || std::abs(dir) > 1.0) && arrive_s > 0.3 && now_off >= 0) {
+      for (int i = -35; i <= 36; ++i) {
+        const double a = i * 5 * M_PI / 180;
+        const double away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
+        if (away < steep - 1e-9 || std::abs(a) <= M_PI / 2) continue;
+        const double free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
+        if (free < P.min_clearance_m + 0.02) continue;
+        const double e = wrapAngle(a - M_PI);  // heading change for the back to face `a`
+        const double tb = std::abs(e) / P.max_turn_rate + togo / (v_back * away) +
+                          0.01 * std::abs(wrapAngle(a - target_bearing));
+        if (tb < best && sweptSeenFree(a, togo + P.min_clearance_m))
+          best = tb, dir = a, best_free = free, steer = true, backwards = true;
+      }
+    }
+    if (steer && backwards) {
+      // The back towards `dir`: turn first beyond 1 rad, then reverse, slowing over the last
+      // 0.1 m of the offset wanted. (The floor was seen free: no slowing for what is ahead.)
+      const double e = wrapAngle(dir - M_PI);
+      v = std::abs(e) > 1.0 ? 0.0 : -v_back * (std::abs(e) > 0.5 ? std::cos(e) : 1.0);
+      v *= std::clamp(togo / 0.1, 0.3, 1.0);
+      out.direction = dir;
+      out.w = P.k_heading * e;
+      out.v = v;
+      have_prev_ = false;
+      return;
     }
     if (steer) {
       // Turn first beyond 1 rad; then drive, slowing down over the last 0.15 m before what is
@@ -360,6 +471,16 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
   const bool fresh = stamp > prev_stamp_ + 1e-9;
   const bool straight = std::abs(wrapAngle(heading - prev_heading_)) < 0.05;
+  if (fresh && have_pose_ && P.rear_memory_s > 0 && P.lane_reverse_speed > 0) {
+    auto& seen = impl_->seen;
+    for (const auto& sc : scans)
+      if (sc.kind == hw::RangeScan::Kind::Laser) seen.push_back({pose_, sc});
+    // A few metres of driving, or a while of turning on the spot; bounded in size whatever
+    // the laser's rate.
+    while (!seen.empty() &&
+           (seen.front().scan.stamp < stamp - P.rear_memory_s || seen.size() > 200))
+      seen.pop_front();
+  }
   if (fresh && have_pose_) {
     // With the robot's pose: follow the nearest obstacle point in front (odometry frame) from
     // scan to scan. A point on something static only slides along its surface (across the

@@ -63,7 +63,15 @@ struct AvoidParams {
   double lane_escape_deg = 60;   // [deg] from the lane's axis (90 = straight out sideways)
   double max_turn_rate = 0.8;    // [rad/s] how fast the base turns (nav.max_w), to choose the
                                  // side out of a lane
-  int sectors = 144;             // polar diagram resolution over 360 deg
+  // Backing out of a walker's lane: where the way out lies behind the robot, reversing along
+  // it (at lane_reverse_speed) is also a way out, taken when it gets out sooner than turning
+  // round to drive forwards. The laser does not see behind the robot, so a way back is taken
+  // only over floor a laser scan of the last rear_memory_s saw free (the robot usually came
+  // that way; the newest scan that covers a spot decides, so someone seen walking into it
+  // since counts). lane_reverse_speed 0 = only forward ways out.
+  double lane_reverse_speed = 0.25;  // [m/s]
+  double rear_memory_s = 10.0;       // [s] laser scans kept to judge the floor behind
+  int sectors = 144;                 // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
     b("robot_radius_m", robot_radius_m);
@@ -88,6 +96,8 @@ struct AvoidParams {
     b("lane_margin_m", lane_margin_m);
     b("lane_escape_deg", lane_escape_deg);
     b("max_turn_rate", max_turn_rate);
+    b("lane_reverse_speed", lane_reverse_speed);
+    b("rear_memory_s", rear_memory_s);
     b("sectors", sectors);
   }
   void validate() const;  // InputError "nav.avoid.<field> = ...: ..."
@@ -200,6 +210,10 @@ class ObstacleAvoider {
   /// Forward speed along the heading for direction `dir`: turn first beyond 1 rad, slow as the
   /// corridor ahead closes, none inside the minimum clearance (sets out.blocked).
   double forwardSpeed(double dir, double v, AvoidOutput& out) const;
+  /// Whether every part of the robot's disc swept `len` metres from its pose along `direction`
+  /// [rad, robot frame] lies on floor the newest remembered laser scan covering it saw free
+  /// (the current scan included; rear_memory_s). Unknown floor is not free.
+  bool sweptSeenFree(double direction, double len) const;
   void laneEscape(const std::vector<std::pair<double, double>>& pts, double target_bearing,
                   double heading, double v_nominal, const Eigen::Vector2d& lane_n, double lane_off,
                   AvoidOutput& out);
