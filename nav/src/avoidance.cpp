@@ -97,7 +97,7 @@ struct ObstacleAvoider::Impl {
   // Laser scans of the last rear_memory_s with the robot's pose when each came in (newest
   // last): what the floor behind the robot, outside the laser's view now, looked like.
   struct Seen {
-    hw::Pose2D pose;
+    double x, y, theta;  // the sensor's pose in the odometry frame when the scan came in
     hw::RangeScan scan;
   };
   std::deque<Seen> seen;
@@ -202,14 +202,9 @@ bool ObstacleAvoider::sweptSeenFree(double direction, double len) const {
         const size_t n = std::min(sc.angles.size(), sc.ranges.size());
         if (n < 2) continue;
         // The sample in this scan's sensor frame.
-        const double th = it->pose.theta + sc.mount.theta;
-        const double mx = it->pose.x + std::cos(it->pose.theta) * sc.mount.x -
-                          std::sin(it->pose.theta) * sc.mount.y;
-        const double my = it->pose.y + std::sin(it->pose.theta) * sc.mount.x +
-                          std::cos(it->pose.theta) * sc.mount.y;
-        const double ex = qx - mx, ey = qy - my;
+        const double ex = qx - it->x, ey = qy - it->y;
         const double r = std::hypot(ex, ey);
-        const double b = wrapAngle(std::atan2(ey, ex) - th);
+        const double b = wrapAngle(std::atan2(ey, ex) - it->theta);
         const double a0 = sc.angles.front(), a1 = sc.angles[n - 1];
         if (b < std::min(a0, a1) || b > std::max(a0, a1)) continue;  // outside its view
         const double step = (a1 - a0) / static_cast<double>(n - 1);
@@ -474,7 +469,12 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   if (fresh && have_pose_ && P.rear_memory_s > 0 && P.lane_reverse_speed > 0) {
     auto& seen = impl_->seen;
     for (const auto& sc : scans)
-      if (sc.kind == hw::RangeScan::Kind::Laser) seen.push_back({pose_, sc});
+      if (sc.kind == hw::RangeScan::Kind::Laser)
+        // The sensor's pose once per scan, not per sample looked up in it.
+        seen.push_back(
+            {pose_.x + std::cos(pose_.theta) * sc.mount.x - std::sin(pose_.theta) * sc.mount.y,
+             pose_.y + std::sin(pose_.theta) * sc.mount.x + std::cos(pose_.theta) * sc.mount.y,
+             pose_.theta + sc.mount.theta, sc});
     // A few metres of driving, or a while of turning on the spot; bounded in size whatever
     // the laser's rate.
     while (!seen.empty() &&
