@@ -265,9 +265,7 @@ int makeBenchSequences(const Args& args, GlobalOptions& g) {
   o.classes = args.getList("classes");
   o.hfov_deg = args.getDouble("hfov");
   if (!(o.hfov_deg > 1 && o.hfov_deg < 179)) throw InputError("--hfov must be in (1, 179) degrees");
-  applyConfig(o.servo, g.config, "servo");
-  o.servo.setCamera(cameraMountFrom(g.config));
-  o.servo.validate();
+  o.servo = servo::turnLawParamsFrom(g.config);
   const auto names = bench::makeSequences(o);
   if (g.json)
     printJson({{"sequences", names}, {"out", o.out_dir}, {"split", bench::toString(o.split)}});
@@ -345,10 +343,7 @@ int runEval(const Args& args, GlobalOptions& g) {
                        " is not a class of the model");
   const std::string out = makeOutputDir(args.get("out"));
   const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
-  servo::TurnLawParams tp;
-  applyConfig(tp, g.config, "servo");
-  tp.setCamera(cameraMountFrom(g.config));
-  tp.validate();
+  const servo::TurnLawParams tp = servo::turnLawParamsFrom(g.config);
   nav::LandmarkPerception perception(model, pp);
   servo::TurnLaw law(tp);
 
@@ -531,10 +526,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     throw InputError("--target " + target + ": not a class of the model (" + known + ")");
   }
   const nav::PerceptionParams pp = nav::perceptionParamsFrom(g.config);
-  servo::TurnLawParams tp;
-  applyConfig(tp, g.config, "servo");
-  tp.setCamera(cameraMountFrom(g.config));
-  tp.validate();
+  const servo::TurnLawParams tp = servo::turnLawParamsFrom(g.config);
   // A camera URI's driver settings (sim.*, camera.*) are applied when it is opened.
   g.config.requireAllUsedExcept({"sim.", "camera."});
   FrameSource source(args.get("frames"), hfov, g.config);

@@ -141,9 +141,7 @@ int runOffline(const std::vector<std::string>& files, const std::vector<double>&
     }
   }
   if (errors.empty()) throw InputError("--offline: no frame with a detection in the given CSVs");
-  servo::TurnLawParams base;
-  applyConfig(base, g.config, "servo");
-  base.setCamera(cameraMountFrom(g.config));
+  const servo::TurnLawParams base = servo::turnLawParamsFrom(g.config);
   g.config.requireAllUsed();
   Json rows = Json::array();
   std::printf("%-8s %8s %10s %10s %12s %10s\n", "lambda", "frames", "mean|w|", "saturated",

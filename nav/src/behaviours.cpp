@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 #include "sketchnav/core/angles.h"
 #include "sketchnav/core/config.h"
@@ -230,6 +231,116 @@ Recovery::Step Recovery::step(const hw::Pose2D& pose, double now, double v_cappe
       blocked) {
     active_ = false;
     out.ended = true;
+  }
+  return out;
+}
+
+void DetourParams::validate() const {
+  require(detour_ahead_m > 0.5 && detour_ahead_m <= 10, "nav.detour_ahead_m",
+          "must be in (0.5, 10] m");
+  require(replan_s > 0, "nav.replan_s", "must be > 0");
+}
+
+double Detour::planTowards(const LocalPlanner& planner, const hw::Pose2D& pose,
+                           const Eigen::Vector2d& goal, double now) {
+  if (now - planned_t_ >= p_.replan_s - 1e-9 || (goal - planned_to_).norm() > 0.3) {
+    path_ = planner.plan({pose.x, pose.y}, goal);
+    planned_t_ = now;
+    planned_to_ = goal;
+  }
+  if (!path_.found) return std::numeric_limits<double>::quiet_NaN();
+  const Eigen::Vector2d c =
+      LocalPlanner::carrot(path_, {pose.x, pose.y}, planner.params().carrot_m);
+  return polarFrom(pose, c).bearing;
+}
+
+std::optional<event::DetourEnd> Detour::end(const char* reason) {
+  if (!active_) return std::nullopt;
+  active_ = false;
+  return event::DetourEnd{reason};
+}
+
+Command Detour::follow(double bearing, const std::function<double(double)>& cap) const {
+  Command c = headFor(bearing, 1.0, drive_);
+  c.v = cap(c.v);
+  c.turn = turnOf(c.w);
+  return c;
+}
+
+Detour::Outcome Detour::whileDodging(const AvoidOutput& av, const LocalPlanner& planner,
+                                     const hw::Pose2D& pose, const Eigen::Vector2d& route_point,
+                                     double now, int section,
+                                     const std::function<double(double)>& cap) {
+  Outcome out;
+  // Once something has come towards the robot in this manoeuvre it stays reactive: the
+  // approach estimate drops while the robot backs off and turns.
+  if (av.started) moving_seen_ = false;
+  moving_seen_ |= av.approach_speed >= 0.25 || av.in_lane;
+  double b = std::numeric_limits<double>::quiet_NaN();
+  if (p_.detour && !moving_seen_) b = planTowards(planner, pose, route_point, now);
+  if (std::isfinite(b)) {
+    if (!active_) {
+      active_ = true;
+      ++count_;
+      out.started = event::DetourStart{path_.length_m, path_.goal, path_.goal_moved, section};
+    }
+    out.command = follow(b, cap);
+  } else {
+    out.ended = end(moving_seen_ ? "coming towards the robot" : "no way found");
+  }
+  return out;
+}
+
+Detour::Outcome Detour::afterDodge(const LocalPlanner& planner, const hw::Pose2D& pose,
+                                   const Eigen::Vector2d& route_point, double now, bool servoing,
+                                   double half_width_m, const std::function<double(double)>& cap) {
+  Outcome out;
+  if (p_.detour_hold && active_ && !servoing) {
+    // Round a box or through a door, heading back to the route before the robot is past it
+    // drives into the same obstacle again.
+    const double b = planTowards(planner, pose, route_point, now);
+    if (planner.segmentClear({pose.x, pose.y}, route_point, half_width_m)) {
+      out.ended = end("route clear");
+    } else if (!std::isfinite(b)) {
+      out.ended = end("no way found");
+    } else {
+      out.command = follow(b, cap);
+    }
+  } else if (servoing) {
+    out.ended = end("servoing");
+  }
+  return out;
+}
+
+YieldBehaviour::Outcome YieldBehaviour::update(const YieldAdvice& adv, const Command& cur,
+                                               const hw::Pose2D& pose,
+                                               const std::function<double(double)>& cap,
+                                               const std::function<double()>& rear_free_m) {
+  Outcome out;
+  if (!adv.active) {
+    if (active_) {
+      active_ = false;
+      out.ended = event::YieldEnd{};
+    }
+    return out;
+  }
+  Command c = cur;
+  if (!adv.in_lane) {
+    c.v = 0;  // about to enter a lane: wait, turning is harmless
+  } else if (adv.v >= 0) {
+    c.v = cap(adv.v);
+    c.w = adv.w;
+  } else {
+    c.v = rear_free_m() > kRearRoomM ? -reverse_speed_ : 0.0;
+    c.w = adv.w;
+  }
+  c.turn = turnOf(c.w);
+  out.command = c;
+  if (!active_) {
+    active_ = true;
+    ++count_;
+    out.started = event::YieldStart{adv.in_lane, adv.clearance_m, adv.mover.position,
+                                    adv.mover.velocity, pose};
   }
   return out;
 }

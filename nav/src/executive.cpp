@@ -24,6 +24,7 @@ void ExecutiveParams::validate() const {
   FinalLookParams::validate();
   RecoverParams::validate();
   DockParams::validate();
+  DetourParams::validate();
   require(tick_s > 0.001 && tick_s <= 0.2, "nav.tick_s", "must be in (0.001, 0.2] s");
   require(camera_period_s > 0 && camera_period_s <= 2, "nav.camera_period_s",
           "must be in (0, 2] s");
@@ -34,9 +35,6 @@ void ExecutiveParams::validate() const {
   require(end_blocked_m >= 0, "nav.end_blocked_m", "must be >= 0");
   require(perception_period_s >= 0, "nav.perception_period_s", "must be >= 0");
   require(goal_stop_s >= 0, "nav.goal_stop_s", "must be >= 0");
-  require(detour_ahead_m > 0.5 && detour_ahead_m <= 10, "nav.detour_ahead_m",
-          "must be in (0.5, 10] m");
-  require(replan_s > 0, "nav.replan_s", "must be > 0");
   require(goal_settle_m >= 0, "nav.goal_settle_m", "must be >= 0");
   require(goal_settle_s > 0, "nav.goal_settle_s", "must be > 0");
   require(section_settle_frac >= 0 && section_settle_frac <= 1, "nav.section_settle_frac",
@@ -56,8 +54,7 @@ NavSettings navSettingsFrom(const Config& c) {
   applyConfig(s.planner, c, "nav.planner");
   applyConfig(s.movers, c, "nav.movers");
   applyConfig(s.goal_door, c, "nav.goal_door");
-  applyConfig(s.servo, c, "servo");
-  s.servo.setCamera(cameraMountFrom(c));
+  s.servo = servo::turnLawParamsFrom(c);
   return s;
 }
 
@@ -156,8 +153,7 @@ struct Executive::Impl {
   // The grid as it was 1.5-3 s ago, for the mover tracker (a person's own trace is not in it).
   LocalPlanner grid_before, grid_snap;
   double snap_t = -1e300;
-  bool yielding = false;
-  int yields = 0;
+  YieldBehaviour yield;
 
   RunStatus status = RunStatus::Idle;
   FailureCode failure = FailureCode::None;
@@ -190,20 +186,14 @@ struct Executive::Impl {
   ProgressChecker progress_checker;
   Recovery recovery;
   Docking docker;
-  // Planned detour (or docking path) being followed, when it was planned and to where.
-  PlannedPath detour;
-  double detour_t = -1e300;
-  Eigen::Vector2d detour_goal{1e300, 1e300};
-  bool detouring = false;
-  bool moving_seen = false;  // the current manoeuvre has seen something come towards the robot
-  bool in_lane = false;      // a walker's lane covered the robot at the last step
+  Detour detour;         // a planned way round (or docking's path)
+  bool in_lane = false;  // a walker's lane covered the robot at the last step
   FollowBehaviour follow;
   // Final look: at the goal, a landmark never seen (too far so far) is looked for before
   // arriving.
   FinalLook final_look;
   bool final_looking = false;  // this tick
   SideLook side_look;          // (its camera's field of view is known once the camera is)
-  int detours = 0;
   SettleChecker settle_checker;
   SectionSettleChecker section_settle;  // an intermediate end the robot cannot get near
   RouteAnchor anchor;                   // the fixes and the refit / realign policy
@@ -226,10 +216,12 @@ struct Executive::Impl {
         movers(st.movers),
         grid_before(st.planner),
         grid_snap(st.planner),
+        yield(st.avoid.reverse_speed),
         landmarks(tracker.route(), st.exec),
         progress_checker(st.exec.stuck_s, st.exec.stuck_m),
         recovery(st.exec, st.avoid.k_heading, st.exec.max_w),
         docker(st.exec),
+        detour(st.exec, st.exec),
         follow(st.exec, st.exec, st.exec.approach_m),
         final_look(st.exec, st.exec.k_heading),
         side_look(st.exec, 0.0, st.exec.k_heading, st.exec.max_w),
@@ -621,11 +613,11 @@ struct Executive::Impl {
       std::function<std::optional<Docking::WayRound>()> plan;
       if (s.exec.detour)
         plan = [&]() -> std::optional<Docking::WayRound> {
-          const double b = planTowards(goal);
+          const double b = detour.planTowards(planner, pose, goal, now);
           if (!std::isfinite(b)) return std::nullopt;
-          const double from_start =
-              (detour.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm();
-          return Docking::WayRound{b, detour.length_m, std::max(0.0, detour.length_m - from_start)};
+          const PlannedPath& way = detour.path();
+          const double from_start = (way.points.front() - Eigen::Vector2d(pose.x, pose.y)).norm();
+          return Docking::WayRound{b, way.length_m, std::max(0.0, way.length_m - from_start)};
         };
       if (const auto d = docker.propose(pg, free, plan, s.exec)) {
         docking = true;
@@ -690,54 +682,30 @@ struct Executive::Impl {
         if (!s.exec.detour_hold) endDetour("avoid ended");
         event(event::AvoidEnd{av.side});
       }
+      const auto cap = [&](double v) { return avoider.capSpeed(scans, v); };
       if (av.active) {
         dodging = true;
-        // Something standing still: follow a way round planned on the grid, back to the route
-        // a few metres on. Something coming towards the robot (a person) is left to the
-        // reactive dodge, whose rules step out of its way.
-        // Once something has come towards the robot in this manoeuvre it stays reactive: the
-        // approach estimate drops while the robot backs off and turns, and a plan through
-        // the grid's picture of the person then led a robot straight into them.
-        if (av.started) moving_seen = false;
-        // A walker's lane too: a detour planned on the grid ignores the lane, and one drove an
-        // exp4-pedestrian-left robot along it into the walker.
-        moving_seen |= av.approach_speed >= 0.25 || av.in_lane;
-        double b = std::numeric_limits<double>::quiet_NaN();
-        if (s.exec.detour && !moving_seen)
-          b = planTowards(tracker.lookahead(pose, s.exec.detour_ahead_m));
-        if (std::isfinite(b)) {
-          if (!detouring) {
-            detouring = true;
-            ++detours;
-            event(event::DetourStart{detour.length_m, detour.goal, detour.goal_moved, k});
-          }
-          arb.propose(Behaviour::Detour, detourCommand(b));
-        } else {
-          endDetour(moving_seen ? "coming towards the robot" : "no way found");
+        // Something standing still: a way round planned on the grid; something coming
+        // towards the robot (a person) or a walker's lane: the reactive dodge (Detour).
+        const auto d = detour.whileDodging(
+            av, planner, pose, tracker.lookahead(pose, s.exec.detour_ahead_m), now, k, cap);
+        if (d.started) event(*d.started);
+        if (d.ended) event(*d.ended);
+        if (d.command)
+          arb.propose(Behaviour::Detour, *d.command);
+        else
           arb.propose(Behaviour::Avoid, {av.v, av.w, turnOf(av.w)});
-        }
       } else {
-        bool held = false;
-        if (s.exec.detour_hold && detouring && !servoing) {
-          // The avoider has let go (the corridor towards the route is free release_m ahead),
-          // but round a box or through a door that is before the robot is past it: heading
-          // back to the route from here drives into the same obstacle again. The detour is
-          // followed until the straight line to the route point it leads to is clear.
-          const Eigen::Vector2d to = tracker.lookahead(pose, s.exec.detour_ahead_m);
-          const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-          const double b = planTowards(to);
-          if (planner.segmentClear({pose.x, pose.y}, to, hwid)) {
-            endDetour("route clear");
-          } else if (!std::isfinite(b)) {
-            endDetour("no way found");
-          } else {
-            dodging = held = true;
-            arb.propose(Behaviour::Detour, detourCommand(b));
-          }
-        } else if (servoing) {
-          endDetour("servoing");
+        const auto d =
+            detour.afterDodge(planner, pose, tracker.lookahead(pose, s.exec.detour_ahead_m), now,
+                              servoing, s.avoid.robot_radius_m + s.avoid.corridor_margin_m, cap);
+        if (d.ended) event(*d.ended);
+        if (d.command) {
+          dodging = true;
+          arb.propose(Behaviour::Detour, *d.command);
+        } else {
+          arb.setWinnerSpeed(cap(arb.winner().v));
         }
-        if (!held) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
       }
     } else {
       endDetour("no range data");
@@ -745,14 +713,14 @@ struct Executive::Impl {
     // Looking to the side for a landmark predicted out of view (SideLook). A look stands the
     // robot still: none starts, and one under way gives way, near a walking person
     // (side_look_walker_m) or in their lane.
-    bool walker_near = in_lane || yielding;
+    bool walker_near = in_lane || yield.active();
     for (const auto& m : walkers)
       walker_near |=
           (m.position - Eigen::Vector2d(pose.x, pose.y)).norm() <= s.exec.side_look_walker_m;
     const auto sl =
         side_look.update(landmarks, att.empty() ? nullptr : &att[0], now, dev.camera != nullptr,
                          docking || recovery.active() || walker_near, final_looking,
-                         (dodging && moving_seen) || walker_near, pose.theta);
+                         (dodging && detour.movingSeen()) || walker_near, pose.theta);
     if (sl.ended) {
       event(*sl.ended);
       progress_checker.reset(pose, now);  // standing still to look is not being stuck
@@ -797,7 +765,7 @@ struct Executive::Impl {
     // beyond the corridor's wall): the section is done where the robot came closest.
     const bool section_settled =
         section_settle.update(sec.length_m, prog.to_end_m, now,
-                              servoing || sl.command.has_value() || yielding) &&
+                              servoing || sl.command.has_value() || yield.active()) &&
         k + 1 < tracker.count() && !end_blocked;
     if (section_settled) {
       event(event::SectionSettled{k, prog.to_end_m});
@@ -829,32 +797,15 @@ struct Executive::Impl {
       const auto adv = s.movers.enabled
                            ? movers.advise(pose, cur.v, cur.w, s.exec.k_heading, s.exec.v_cruise)
                            : movers.holdShortOfWalkerLanes(pose, cur.v, cur.w);
-      if (adv.active) {
-        Command c = cur;
-        if (!adv.in_lane) {
-          c.v = 0;
-        } else if (adv.v >= 0) {
-          c.v = avoider.capSpeed(scans, adv.v);
-          c.w = adv.w;
-        } else {
-          const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-          c.v = corridorFree(scanPoints(scans), M_PI, hwid, s.avoid.max_range_m) > 0.5
-                    ? -s.avoid.reverse_speed
-                    : 0.0;
-          c.w = adv.w;
-        }
-        c.turn = turnOf(c.w);
-        arb.propose(Behaviour::Yield, c);
-        if (!yielding) {
-          yielding = true;
-          ++yields;
-          event(event::YieldStart{adv.in_lane, adv.clearance_m, adv.mover.position,
-                                  adv.mover.velocity, pose});
-        }
-      } else if (yielding) {
-        yielding = false;
-        event(event::YieldEnd{});
-      }
+      const auto y = yield.update(
+          adv, cur, pose, [&](double v) { return avoider.capSpeed(scans, v); },
+          [&] {
+            const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
+            return corridorFree(scanPoints(scans), M_PI, hwid, s.avoid.max_range_m);
+          });
+      if (y.command) arb.propose(Behaviour::Yield, *y.command);
+      if (y.started) event(*y.started);
+      if (y.ended) event(*y.ended);
     }
     if (final_looking) {
       // Turn on the spot to where the sketch puts the landmark (perception attends it once it
@@ -933,31 +884,8 @@ struct Executive::Impl {
     tracker.setGoalOdom(goal);
   }
 
-  // Bearing [rad, robot frame] of the carrot on a path planned to `goal` (odometry frame),
-  // replanned every replan_s or when the goal moved; NaN when there is no way there.
-  double planTowards(const Eigen::Vector2d& goal) {
-    if (now - detour_t >= s.exec.replan_s - 1e-9 || (goal - detour_goal).norm() > 0.3) {
-      detour = planner.plan({pose.x, pose.y}, goal);
-      detour_t = now;
-      detour_goal = goal;
-    }
-    if (!detour.found) return std::numeric_limits<double>::quiet_NaN();
-    const Eigen::Vector2d c =
-        LocalPlanner::carrot(detour, {pose.x, pose.y}, planner.params().carrot_m);
-    return polarFrom(pose, c).bearing;
-  }
-  // Along a planned detour: towards bearing `b` [rad, robot frame] of its carrot, the speed
-  // capped by the clearance ahead.
-  Command detourCommand(double b) {
-    Command c = headFor(b, 1.0, s.exec);
-    c.v = avoider.capSpeed(scans, c.v);
-    c.turn = turnOf(c.w);
-    return c;
-  }
   void endDetour(const char* reason) {
-    if (!detouring) return;
-    detouring = false;
-    event(event::DetourEnd{reason});
+    if (const auto e = detour.end(reason)) event(*e);
   }
 
   // At the goal: whether to stay and look for a never-seen landmark of the last section within
@@ -1133,8 +1061,8 @@ ExecutiveSummary Executive::summary() const {
   lt.track_ms = I.track_ms.summary();
   s.avoidance_manoeuvres = I.manoeuvres;
   s.recoveries = I.recovery.count();
-  s.detours = I.detours;
-  s.yields = I.yields;
+  s.detours = I.detour.count();
+  s.yields = I.yield.count();
   s.laser_odometry = I.lodo.stats();
   return s;
 }

@@ -1,10 +1,12 @@
-// The executive's small behaviours on their own: heading for a bearing, following and looking,
-// looking to the side, the final look at the goal, the stuck recovery and docking.
+// The executive's behaviours on their own: heading for a bearing, following and looking,
+// looking to the side, the final look at the goal, the stuck recovery, docking, detours and
+// giving way to walking people.
 #include <gtest/gtest.h>
 
 #include <cmath>
 
 #include "route_util.h"
+#include "scan_sim.h"
 #include "sketchnav/nav/behaviours.h"
 
 namespace sketchnav::nav {
@@ -333,6 +335,151 @@ TEST(Docking, DrivesAFreeLineOrAShortWayRoundToTheGoal) {
   EXPECT_FALSE(dock.propose(at(1.2, 0.0), 0.5, nullptr, drive));
 }
 
+TEST(Detour, GoesRoundWhatStandsStillAndLeavesWhatComesTowardsTheRobotToTheDodge) {
+  LocalPlanner planner;
+  auto boxes = test::room();
+  boxes.push_back({3, 0, 0.3, 0.3});  // in the way of the route along y = 0
+  planner.insert({0, 0, 0}, test::scanAt({0, 0, 0}, boxes));
+  const hw::Pose2D pose{0, 0, 0};
+  const Eigen::Vector2d route_point(6, 0);
+  const auto free = [](double v) { return v; };
+  Detour d(DetourParams{}, DriveParams{});
+  AvoidOutput av;
+  av.active = av.started = true;
+  // Something standing still: a way round, planned once and followed.
+  auto o = d.whileDodging(av, planner, pose, route_point, 0.0, 2, free);
+  ASSERT_TRUE(o.started);
+  EXPECT_EQ(o.started->section, 2);
+  EXPECT_GT(o.started->length_m, 6.0);  // round the box, not through it
+  ASSERT_TRUE(o.command);
+  EXPECT_NE(o.command->turn, servo::Turn::Straight);
+  EXPECT_TRUE(d.active());
+  av.started = false;
+  o = d.whileDodging(av, planner, pose, route_point, 0.1, 2,
+                     [](double v) { return std::min(v, 0.1); });
+  EXPECT_FALSE(o.started);
+  ASSERT_TRUE(o.command);
+  EXPECT_LE(o.command->v, 0.1);  // the clearance ahead caps it
+  EXPECT_EQ(d.count(), 1);
+  // Something comes towards the robot: the reactive dodge drives for the rest of the
+  // manoeuvre, even once the approach estimate drops.
+  av.approach_speed = 0.4;
+  o = d.whileDodging(av, planner, pose, route_point, 0.2, 2, free);
+  ASSERT_TRUE(o.ended);
+  EXPECT_EQ(o.ended->reason, "coming towards the robot");
+  EXPECT_FALSE(o.command);
+  EXPECT_TRUE(d.movingSeen());
+  av.approach_speed = 0;
+  o = d.whileDodging(av, planner, pose, route_point, 0.3, 2, free);
+  EXPECT_FALSE(o.command || o.ended || o.started);
+  // A walker's lane counts the same; a new manoeuvre forgets.
+  av.started = true;
+  o = d.whileDodging(av, planner, pose, route_point, 0.4, 2, free);
+  EXPECT_TRUE(o.command && o.started);
+  EXPECT_EQ(d.count(), 2);
+  av.started = false;
+  av.in_lane = true;
+  o = d.whileDodging(av, planner, pose, route_point, 0.5, 2, free);
+  EXPECT_FALSE(o.command);
+  ASSERT_TRUE(o.ended);
+
+  // Off: never planned.
+  DetourParams off;
+  off.detour = false;
+  Detour none(off, DriveParams{});
+  av = AvoidOutput{};
+  av.active = av.started = true;
+  o = none.whileDodging(av, planner, pose, route_point, 0.0, 0, free);
+  EXPECT_FALSE(o.command || o.started || o.ended);
+}
+
+TEST(Detour, HeldAfterTheDodgeUntilTheLineToTheRouteIsClear) {
+  LocalPlanner planner;
+  auto boxes = test::room();
+  boxes.push_back({3, 0, 0.3, 0.3});
+  planner.insert({0, 0, 0}, test::scanAt({0, 0, 0}, boxes));
+  const auto free = [](double v) { return v; };
+  const double hwid = 0.3;
+  DetourParams hold;
+  hold.detour_hold = true;
+  Detour d(hold, DriveParams{});
+  AvoidOutput av;
+  av.active = av.started = true;
+  ASSERT_TRUE(d.whileDodging(av, planner, {0, 0, 0}, {6, 0}, 0.0, 0, free).command);
+  // The avoider has let go, the box still between the robot and the route point: held.
+  auto o = d.afterDodge(planner, {1.5, 0.5, 0}, {6, 0}, 0.1, false, hwid, free);
+  EXPECT_TRUE(o.command);
+  EXPECT_FALSE(o.ended);
+  // Past the box: the line is clear, the detour ends.
+  o = d.afterDodge(planner, {4.5, 0.8, 0}, {6, 0}, 0.2, false, hwid, free);
+  EXPECT_FALSE(o.command);
+  ASSERT_TRUE(o.ended);
+  EXPECT_EQ(o.ended->reason, "route clear");
+  EXPECT_FALSE(d.active());
+  // Without holding, the servo taking over ends it, and nothing else does.
+  Detour plain(DetourParams{}, DriveParams{});
+  ASSERT_TRUE(plain.whileDodging(av, planner, {0, 0, 0}, {6, 0}, 0.0, 0, free).command);
+  o = plain.afterDodge(planner, {1.5, 0.8, 0}, {6, 0}, 0.1, false, hwid, free);
+  EXPECT_FALSE(o.command || o.ended);
+  o = plain.afterDodge(planner, {1.5, 0.8, 0}, {6, 0}, 0.2, true, hwid, free);
+  ASSERT_TRUE(o.ended);
+  EXPECT_EQ(o.ended->reason, "servoing");
+}
+
+TEST(YieldBehaviour, WaitsShortOfALaneStepsOutOfOneAndBacksOnlyWithRoom) {
+  YieldBehaviour y(0.1);
+  const Command cur{0.3, 0.2, servo::Turn::Left};
+  const hw::Pose2D pose{1, 2, 0.5};
+  int asked = 0;
+  double rear = 0.4;
+  const auto rear_free = [&] {
+    ++asked;
+    return rear;
+  };
+  const auto half = [](double v) { return 0.5 * v; };
+  YieldAdvice adv;
+  auto o = y.update(adv, cur, pose, half, rear_free);
+  EXPECT_FALSE(o.command || o.started || o.ended);
+  // About to enter a lane: wait, the turn kept.
+  adv.active = true;
+  adv.clearance_m = 1.7;
+  adv.mover.position = {3, 2};
+  o = y.update(adv, cur, pose, half, rear_free);
+  ASSERT_TRUE(o.command && o.started);
+  EXPECT_EQ(o.command->v, 0.0);
+  EXPECT_EQ(o.command->w, 0.2);
+  EXPECT_FALSE(o.started->in_lane);
+  EXPECT_DOUBLE_EQ(o.started->clearance_m, 1.7);
+  EXPECT_EQ(o.started->mover_odom, Eigen::Vector2d(3, 2));
+  // In one: step out as advised, capped by the clearance ahead; one yield, not two.
+  adv.in_lane = true;
+  adv.v = 0.2;
+  adv.w = -0.5;
+  o = y.update(adv, cur, pose, half, rear_free);
+  ASSERT_TRUE(o.command);
+  EXPECT_FALSE(o.started);
+  EXPECT_DOUBLE_EQ(o.command->v, 0.1);
+  EXPECT_EQ(o.command->turn, servo::Turn::Right);
+  EXPECT_EQ(asked, 0);
+  // Backing: only with room behind.
+  adv.v = -0.1;
+  o = y.update(adv, cur, pose, half, rear_free);
+  EXPECT_EQ(o.command->v, 0.0);
+  rear = 2.0;
+  o = y.update(adv, cur, pose, half, rear_free);
+  EXPECT_DOUBLE_EQ(o.command->v, -0.1);
+  EXPECT_EQ(asked, 2);
+  EXPECT_TRUE(y.active());
+  // The lane is clear: the yield ends once.
+  adv.active = false;
+  o = y.update(adv, cur, pose, half, rear_free);
+  EXPECT_TRUE(o.ended);
+  EXPECT_FALSE(o.command);
+  EXPECT_FALSE(y.active());
+  EXPECT_FALSE(y.update(adv, cur, pose, half, rear_free).ended);
+  EXPECT_EQ(y.count(), 1);
+}
+
 TEST(BehaviourParams, ValidateNamesTheSetting) {
   auto names = [](auto p, auto&& spoil, const char* key) {
     EXPECT_NO_THROW(p.validate());
@@ -346,6 +493,10 @@ TEST(BehaviourParams, ValidateNamesTheSetting) {
   };
   names(
       DriveParams{}, [](DriveParams& p) { p.max_w = 0; }, "nav.max_w");
+  names(
+      DetourParams{}, [](DetourParams& p) { p.detour_ahead_m = 0.5; }, "nav.detour_ahead_m");
+  names(
+      DetourParams{}, [](DetourParams& p) { p.replan_s = 0; }, "nav.replan_s");
   names(
       LookParams{}, [](LookParams& p) { p.look_bearing_deg = 95; }, "nav.look_bearing_deg");
   names(

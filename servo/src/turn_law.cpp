@@ -155,4 +155,12 @@ Offset robustOffset(const std::vector<double>& x_t, const std::vector<double>& x
   return o;
 }
 
+TurnLawParams turnLawParamsFrom(const Config& config) {
+  TurnLawParams p;
+  applyConfig(p, config, "servo");
+  p.setCamera(cameraMountFrom(config));
+  p.validate();
+  return p;
+}
+
 }  // namespace sketchnav::servo

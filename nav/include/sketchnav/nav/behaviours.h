@@ -1,10 +1,10 @@
 #pragma once
-// The executive's behaviours that are small enough to stand alone: following the route (and
-// looking towards an expected landmark on the way), looking to the side, the final look at
-// the goal, and the stuck recovery. Each has its own Params (keys directly under "nav.":
-// ExecutiveParams derives from them) and reports what it did as an outcome — the command it
-// proposes (CommandArbiter decides), the event to report — and never touches the devices, the
-// run's status or the route.
+// The executive's behaviours: following the route (and looking towards an expected landmark
+// on the way), looking to the side, the final look at the goal, docking, the stuck recovery,
+// detours planned round what stands in the way, and giving way to walking people. Each has its own
+// Params (keys directly under "nav.": ExecutiveParams derives from them) and reports what it did as
+// an outcome — the command it proposes (CommandArbiter decides), the event to report — and never
+// touches the devices, the run's status or the route.
 #include <functional>
 #include <map>
 #include <optional>
@@ -12,9 +12,12 @@
 #include <vector>
 
 #include "sketchnav/hw/types.h"
+#include "sketchnav/nav/avoidance.h"
 #include "sketchnav/nav/command_arbiter.h"
 #include "sketchnav/nav/events.h"
 #include "sketchnav/nav/landmark_tracker.h"
+#include "sketchnav/nav/local_planner.h"
+#include "sketchnav/nav/movers.h"
 #include "sketchnav/nav/sections.h"
 
 namespace sketchnav::nav {
@@ -317,6 +320,114 @@ class Recovery {
   int count_ = 0;
   double dir_ = 0, t0_ = 0;  // escape heading (odometry frame), start time
   hw::Pose2D from_;
+};
+
+/// Detours (local_planner.h): while the avoider dodges something that is not coming towards
+/// the robot, the robot follows a path planned on the laser's occupancy grid to the route
+/// point detour_ahead_m on, instead of the reactive dodge; and near the goal, with no free
+/// straight line to it, a path to the goal (Docking). Replanned every replan_s.
+struct DetourParams {
+  bool detour = true;
+  double detour_ahead_m = 3.0;  // [m]
+  // A detour once started is followed until the straight line to that route point is clear
+  // on the grid (or no way is found, someone comes towards the robot, or the servo takes
+  // over), not only while the reactive avoider is dodging: the avoider lets go when the
+  // corridor towards the route is free avoid.release_m ahead, which round a box or a door
+  // frame comes before the robot is past it. false = ends with the avoider's manoeuvre.
+  // Off by default: doc/navigation.md "Evidence for the defaults".
+  bool detour_hold = false;
+  double replan_s = 0.5;  // [s]
+  template <class B>
+  void bind(B& b) {
+    b("detour", detour);
+    b("detour_ahead_m", detour_ahead_m);
+    b("detour_hold", detour_hold);
+    b("replan_s", replan_s);
+  }
+  void validate() const;  // InputError "nav.<field> = ...: ..."
+};
+
+class Detour {
+ public:
+  /// `drive`: how the path's carrot is headed for.
+  Detour(DetourParams p, DriveParams drive) : p_(p), drive_(drive) {}
+
+  /// Bearing [rad, robot frame] of the carrot on a path planned on `planner`'s grid from
+  /// `pose` to `goal` (odometry frame), replanned every replan_s or when the goal moved by
+  /// more than 0.3 m since the last plan (`now` [s]); NaN when there is no way there.
+  double planTowards(const LocalPlanner& planner, const hw::Pose2D& pose,
+                     const Eigen::Vector2d& goal, double now);
+  /// The path planned last (a detour's or docking's way round).
+  const PlannedPath& path() const { return path_; }
+  /// A detour is being followed.
+  bool active() const { return active_; }
+  /// The current avoidance manoeuvre has seen something come towards the robot (then it is
+  /// left to the reactive dodge until the manoeuvre ends).
+  bool movingSeen() const { return moving_seen_; }
+  int count() const { return count_; }  // detours started
+  /// Ends the detour under way, for `reason` (event::DetourEnd); none when none is.
+  std::optional<event::DetourEnd> end(const char* reason);
+
+  struct Outcome {
+    std::optional<Command> command;  // the detour drives (Behaviour::Detour); none: it does not
+    std::optional<event::DetourStart> started;
+    std::optional<event::DetourEnd> ended;
+  };
+  /// One tick while the avoider dodges (`av`: its step this tick). Something standing still
+  /// is gone round on a path planned to `route_point` (the route point detour_ahead_m on);
+  /// once something has come towards the robot in the manoeuvre (approach_speed >= 0.25 m/s,
+  /// or a walker's lane: a path planned through the grid's picture of a person led a robot
+  /// into them) the reactive dodge drives until the manoeuvre ends. `section`: for the event;
+  /// `cap`: the forward speed allowed by the clearance ahead (ObstacleAvoider::capSpeed).
+  Outcome whileDodging(const AvoidOutput& av, const LocalPlanner& planner, const hw::Pose2D& pose,
+                       const Eigen::Vector2d& route_point, double now, int section,
+                       const std::function<double(double)>& cap);
+  /// One tick while the avoider does not dodge. With detour_hold a detour under way is
+  /// followed (command) until the straight line from the robot to `route_point` keeps
+  /// `half_width_m` [m] clear on the grid, no way is found, or `servoing`; without it,
+  /// servoing ends it.
+  Outcome afterDodge(const LocalPlanner& planner, const hw::Pose2D& pose,
+                     const Eigen::Vector2d& route_point, double now, bool servoing,
+                     double half_width_m, const std::function<double(double)>& cap);
+
+ private:
+  Command follow(double bearing, const std::function<double(double)>& cap) const;
+  DetourParams p_;
+  DriveParams drive_;
+  PlannedPath path_;
+  double planned_t_ = -1e300;                 // [s] when path_ was planned
+  Eigen::Vector2d planned_to_{1e300, 1e300};  // and to where (odometry frame)
+  bool active_ = false, moving_seen_ = false;
+  int count_ = 0;
+};
+
+/// Giving way to walking people (MoverTracker::advise, or holdShortOfWalkerLanes with lane
+/// keeping off): about to enter a walker's lane, the robot waits (the command's turn kept);
+/// in one, it steps out as advised, backing only with room behind it.
+class YieldBehaviour {
+ public:
+  /// `reverse_speed` [m/s]: backing out of a lane.
+  explicit YieldBehaviour(double reverse_speed) : reverse_speed_(reverse_speed) {}
+  struct Outcome {
+    std::optional<Command> command;  // replaces the one that would drive (Behaviour::Yield)
+    std::optional<event::YieldStart> started;
+    std::optional<event::YieldEnd> ended;
+  };
+  /// One tick: `adv` the advice for `cur` (the command that would drive otherwise) at `pose`;
+  /// `cap`: the forward speed allowed by the clearance ahead; `rear_free_m`: the free length
+  /// [m] of the corridor behind the robot (asked only when the advice is to back; it backs
+  /// only with more than kRearRoomM of it).
+  Outcome update(const YieldAdvice& adv, const Command& cur, const hw::Pose2D& pose,
+                 const std::function<double(double)>& cap,
+                 const std::function<double()>& rear_free_m);
+  bool active() const { return active_; }
+  int count() const { return count_; }
+  static constexpr double kRearRoomM = 0.5;  // [m]
+
+ private:
+  double reverse_speed_;
+  bool active_ = false;
+  int count_ = 0;
 };
 
 }  // namespace sketchnav::nav

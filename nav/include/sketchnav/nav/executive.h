@@ -45,7 +45,8 @@ struct ExecutiveParams : DriveParams,
                          SideLookParams,
                          FinalLookParams,
                          RecoverParams,
-                         DockParams {
+                         DockParams,
+                         DetourParams {
   double tick_s = 0.05;              // [s] control period
   double camera_period_s = 0.1;      // [s] expected frame period (frames are grabbed at this pace)
   double max_time_s = 900;           // [s] whole run
@@ -71,20 +72,6 @@ struct ExecutiveParams : DriveParams,
   // twice as far away (3 -> 5 m), and with far sightings kept as bearings (fit_bearing_only) their
   // rays cross over a longer baseline, which places them without the laser's range.
   bool fovea_hints = true;
-  // Detours (local_planner.h): when the avoider is dodging something that is not coming
-  // towards the robot, the robot follows a path planned on the laser's occupancy grid to the
-  // route point detour_ahead_m on, instead of the reactive dodge; and near the goal, with no
-  // free straight line to it, a path to the goal. Replanned every replan_s.
-  bool detour = true;
-  double detour_ahead_m = 3.0;  // [m]
-  // A detour once started is followed until the straight line to that route point is clear
-  // on the grid (or no way is found, someone comes towards the robot, or the servo takes
-  // over), not only while the reactive avoider is dodging: the avoider lets go when the
-  // corridor towards the route is free avoid.release_m ahead, which round a box or a door
-  // frame comes before the robot is past it. false = ends with the avoider's manoeuvre.
-  // Off by default: doc/navigation.md "Evidence for the defaults".
-  bool detour_hold = false;
-  double replan_s = 0.5;  // [s]
   template <class B>
   void bind(B& b) {
     DriveParams::bind(b);
@@ -95,6 +82,7 @@ struct ExecutiveParams : DriveParams,
     FinalLookParams::bind(b);
     RecoverParams::bind(b);
     DockParams::bind(b);
+    DetourParams::bind(b);
     b("tick_s", tick_s);
     b("camera_period_s", camera_period_s);
     b("max_time_s", max_time_s);
@@ -109,10 +97,6 @@ struct ExecutiveParams : DriveParams,
     b("section_settle_frac", section_settle_frac);
     b("section_settle_s", section_settle_s);
     b("fovea_hints", fovea_hints);
-    b("detour", detour);
-    b("detour_ahead_m", detour_ahead_m);
-    b("detour_hold", detour_hold);
-    b("replan_s", replan_s);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };

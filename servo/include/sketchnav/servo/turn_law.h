@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "sketchnav/core/camera_mount.h"
+#include "sketchnav/core/config.h"
 
 namespace sketchnav::servo {
 
@@ -54,6 +55,10 @@ struct TurnLawParams {
     camera_z_m = m.z_m;
   }
 };
+
+/// The "servo.*" settings of `config`, the camera's position from its mount (robot.camera.*,
+/// cameraMountFrom), validated (InputError naming the field).
+TurnLawParams turnLawParamsFrom(const Config& config);
 
 struct TurnCommand {
   double v = 0;                                               // [m/s] forward speed
