@@ -155,10 +155,32 @@ Offset robustOffset(const std::vector<double>& x_t, const std::vector<double>& x
   return o;
 }
 
+namespace {
+// The robot's cruise speed, "nav.v_cruise" (bound again in nav::DriveParams, which validates it
+// the same way): servoing keeps it.
+struct Cruise {
+  double v_cruise = 0.30;  // [m/s]
+  template <class B>
+  void bind(B& b) {
+    b("v_cruise", v_cruise);
+  }
+  void validate() const {
+    require(v_cruise > 0 && v_cruise <= 2, "nav.v_cruise", "must be in (0, 2] m/s");
+  }
+};
+}  // namespace
+
 TurnLawParams turnLawParamsFrom(const Config& config) {
+  if (config.has("servo.v_forward"))
+    throw InputError(config.origin("servo.v_forward") +
+                     ": setting 'servo.v_forward' is now 'nav.v_cruise' (servoing keeps the "
+                     "robot's cruise speed)");
   TurnLawParams p;
   applyConfig(p, config, "servo");
   p.setCamera(cameraMountFrom(config));
+  Cruise cruise;
+  applyConfig(cruise, config, "nav");
+  p.v_forward = cruise.v_cruise;
   p.validate();
   return p;
 }

@@ -205,3 +205,31 @@ TEST(TurnLawParams, ValidateNamesTheField) {
   }
   EXPECT_THROW(TurnLaw().compute(NAN, 0), std::invalid_argument);
 }
+
+// One name per quantity: servoing keeps the robot's cruise speed (nav.v_cruise) and takes the
+// camera's position from the mount; the old servo.v_forward names the setting that replaced it.
+TEST(TurnLawParams, FromTheSettingsWithTheCruiseSpeedAndTheCameraMount) {
+  Config c;
+  c.set("nav.v_cruise=0.45");
+  c.set("robot.camera.x_m=0.2");
+  c.set("servo.lambda=0.5");
+  const TurnLawParams p = turnLawParamsFrom(c);
+  EXPECT_DOUBLE_EQ(p.v_forward, 0.45);
+  EXPECT_DOUBLE_EQ(p.camera_x_m, 0.2);
+  EXPECT_DOUBLE_EQ(p.lambda, 0.5);
+  EXPECT_TRUE(c.unusedKeys().empty());
+  EXPECT_DOUBLE_EQ(TurnLaw(p).compute(0.3, 2.0).v, 0.45);
+  Config old;
+  old.set("servo.v_forward=0.2");
+  try {
+    turnLawParamsFrom(old);
+    FAIL() << "servo.v_forward accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'servo.v_forward' is now 'nav.v_cruise'"),
+              std::string::npos)
+        << e.what();
+  }
+  Config bad;
+  bad.set("nav.v_cruise=-1");
+  EXPECT_THROW(turnLawParamsFrom(bad), InputError);
+}

@@ -28,8 +28,10 @@ enum class Turn { Left, Straight, Right };
 const char* toString(Turn t);
 
 struct TurnLawParams {
-  double lambda = 0.8;      // [1/s] turn-radius gain: larger = sharper turns for an offset
-  double v_forward = 0.30;  // [m/s] forward speed kept while servoing
+  double lambda = 0.8;  // [1/s] turn-radius gain: larger = sharper turns for an offset
+  // [m/s] forward speed kept while servoing: the robot's cruise speed (the "nav.v_cruise"
+  // setting, turnLawParamsFrom), not a setting of its own.
+  double v_forward = 0.30;
   double max_w = 0.6;       // [rad/s] yaw-rate saturation (also bounds the turn radius)
   double dead_band = 0.02;  // [normalised] |x_t - x_d| below this -> Straight, w = 0
   // The camera's position, from the camera mount (the "robot.camera.*" settings, CameraMount
@@ -41,7 +43,6 @@ struct TurnLawParams {
   template <class B>
   void bind(B& b) {
     b("lambda", lambda);
-    b("v_forward", v_forward);
     b("max_w", max_w);
     b("dead_band", dead_band);
     b("default_depth_m", default_depth_m);
@@ -57,7 +58,8 @@ struct TurnLawParams {
 };
 
 /// The "servo.*" settings of `config`, the camera's position from its mount (robot.camera.*,
-/// cameraMountFrom), validated (InputError naming the field).
+/// cameraMountFrom) and the forward speed from nav.v_cruise, validated (InputError naming the
+/// field). The old key servo.v_forward is an InputError naming nav.v_cruise.
 TurnLawParams turnLawParamsFrom(const Config& config);
 
 struct TurnCommand {
