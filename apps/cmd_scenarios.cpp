@@ -305,7 +305,10 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
     r["time_s"] = sm.contains("time_s") ? sm["time_s"] : Json(nullptr);
     r["min_clearance_m"] = sm.contains("min_clearance_m") ? sm["min_clearance_m"] : Json(nullptr);
     const Telemetry t = readTelemetry(dir, w);
-    r["clearance_people_m"] = numOrNull(t.people_m);
+    // The simulator's own figure (every step, people's waits included); from the telemetry's
+    // rows for run folders written before it reported one.
+    r["clearance_people_m"] = sm.contains("min_clearance_people_m") ? sm["min_clearance_people_m"]
+                                                                    : numOrNull(t.people_m);
     r["clearance_obstacles_m"] = numOrNull(t.obstacles_m);
     r["mode_share"] = t.mode_share;
     r["events"] = eventCounts(dir);

@@ -631,6 +631,7 @@ Json runNavigation(const RunOptions& o) {
   if (simr) rs.sim = simr->params();
   s["settings"] = runSettingsJson(rs, simr != nullptr);
   s["min_clearance_m"] = nullptr;
+  s["min_clearance_people_m"] = nullptr;
   s["deviation_m"] = nullptr;
 
   RouteToWorld r2w;
@@ -652,6 +653,8 @@ Json runNavigation(const RunOptions& o) {
     s["at_goal"] = at_goal;
     s["distance_to_goal_m"] = to_goal;
     s["min_clearance_m"] = simr->minClearance();
+    const double people = simr->minClearancePeople();
+    s["min_clearance_people_m"] = std::isfinite(people) ? Json(people) : Json(nullptr);
     s["path_length_m"] = simr->stats().distance;
     s["frames_rendered"] = simr->stats().frames_rendered;
     // Where the robot's belief went wrong, against ground truth: its odometry (the executive's

@@ -24,6 +24,7 @@ RunSummary RunSummary::fromJson(const Json& s) {
   r.real_time_factor = number(s, "real_time_factor", 0);
   r.path_length_m = number(s, "path_length_m", 0);
   r.min_clearance_m = number(s, "min_clearance_m", NAN);
+  r.min_clearance_people_m = number(s, "min_clearance_people_m", NAN);
   if (s.contains("deviation_m") && s["deviation_m"].is_object()) {
     r.deviation_mean_m = number(s["deviation_m"], "mean", NAN);
     r.deviation_max_m = number(s["deviation_m"], "max", NAN);

@@ -12,7 +12,7 @@ TEST(RunSummary, ReadsTheFiguresOfASimulatedRun) {
   const Json j = Json::parse(R"({
     "success": true, "executive_success": false, "reason": "reached the goal region",
     "failure": "", "time_s": 92.3, "wall_time_s": 80.0, "real_time_factor": 1.15,
-    "path_length_m": 22.8, "min_clearance_m": 0.31,
+    "path_length_m": 22.8, "min_clearance_m": 0.31, "min_clearance_people_m": 0.52,
     "deviation_m": {"mean": 0.2, "max": 0.6},
     "diagnostics": {"odometry_error_m": 0.04, "sketch_goal_error_m": 0.06},
     "seed": 1})");
@@ -26,6 +26,7 @@ TEST(RunSummary, ReadsTheFiguresOfASimulatedRun) {
   EXPECT_DOUBLE_EQ(s.real_time_factor, 1.15);
   EXPECT_DOUBLE_EQ(s.path_length_m, 22.8);
   EXPECT_DOUBLE_EQ(s.min_clearance_m, 0.31);
+  EXPECT_DOUBLE_EQ(s.min_clearance_people_m, 0.52);
   EXPECT_DOUBLE_EQ(s.deviation_mean_m, 0.2);
   EXPECT_DOUBLE_EQ(s.deviation_max_m, 0.6);
   ASSERT_TRUE(s.diagnostics.has_value());
@@ -40,12 +41,13 @@ TEST(RunSummary, ReadsTheFiguresOfASimulatedRun) {
 TEST(RunSummary, FiguresARunCouldNotMeasureStayUnset) {
   const RunSummary s = RunSummary::fromJson(
       Json::parse(R"({"success": false, "reason": "lost", "min_clearance_m": null,
-                      "deviation_m": null})"));
+                      "min_clearance_people_m": null, "deviation_m": null})"));
   EXPECT_FALSE(s.success);
   EXPECT_EQ(s.reason, "lost");
   EXPECT_EQ(s.failure, "");  // a summary older than the failure code
   EXPECT_DOUBLE_EQ(s.time_s, 0);
   EXPECT_TRUE(std::isnan(s.min_clearance_m));
+  EXPECT_TRUE(std::isnan(s.min_clearance_people_m));
   EXPECT_TRUE(std::isnan(s.deviation_mean_m));
   EXPECT_FALSE(s.diagnostics.has_value());
 }

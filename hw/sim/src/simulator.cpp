@@ -123,6 +123,11 @@ struct Simulator::Impl {
   bool collided = false;
   std::string collided_with;
   double min_clearance = geom::kInf;
+  double min_clearance_people = geom::kInf;
+  // Per pedestrian: how long it has waited behind the robot so far [s] (it is where its path
+  // puts it at t - waited), and whether it is waiting now.
+  std::vector<double> waited;
+  std::vector<char> waiting;
   double clearance = geom::kInf;
   double distance = 0;
   std::vector<TrajectorySample> trajectory;
@@ -147,7 +152,9 @@ struct Simulator::Impl {
         vehicle(p.substep),
         rng_motion(p.seed * 1000003ULL + 1),
         rng_camera(p.seed * 1000003ULL + 2),
-        rng_range(p.seed * 1000003ULL + 3) {}
+        rng_range(p.seed * 1000003ULL + 3),
+        waited(w.pedestrians.size(), 0.0),
+        waiting(w.pedestrians.size(), 0) {}
 
   hw::Pose2D gt() const {
     const auto& p = vehicle.getCurrentGTPose();
@@ -156,8 +163,38 @@ struct Simulator::Impl {
 
   std::vector<PedestrianState> pedestriansAt(double t) const {
     std::vector<PedestrianState> out;
-    for (const auto& p : world.pedestrians) out.push_back(pedestrianAt(p, t));
+    for (size_t i = 0; i < world.pedestrians.size(); ++i) {
+      out.push_back(pedestrianAt(world.pedestrians[i], t - waited[i]));
+      if (waiting[i]) out.back().velocity.setZero();
+    }
     return out;
+  }
+
+  // Who waits behind the robot (at `robot`, driving at `speed` [m/s]) over the step to t_next
+  // (SimParams::pedestrian_keep_behind_m).
+  void updateWaits(const hw::Pose2D& robot, double speed, double t_next, double dt) {
+    const double keep = params.pedestrian_keep_behind_m;
+    const Vec2 c(robot.x, robot.y), heading(std::cos(robot.theta), std::sin(robot.theta));
+    for (size_t i = 0; i < world.pedestrians.size(); ++i) {
+      waiting[i] = 0;
+      if (keep <= 0) continue;
+      const auto& p = world.pedestrians[i];
+      const PedestrianState st = pedestrianAt(p, t_next - waited[i]);  // walking on
+      const double walk = st.velocity.norm();
+      const Vec2 d = c - st.position;  // to the robot
+      const double dist = d.norm();
+      if (walk < 1e-9 || dist < 1e-9) continue;
+      const Vec2 u = st.velocity / walk;
+      const double reach = p.radius + world.robot.radius;
+      const double along = d.dot(u);
+      const bool in_way = along > 0 && (d - along * u).norm() < reach + 0.1;
+      const bool at_its_back = heading.dot(-d) < 0;
+      const bool driving_at = speed * heading.dot(-d / dist) > 0.05;
+      if (in_way && at_its_back && !driving_at && dist - reach < keep) {
+        waited[i] += dt;
+        waiting[i] = 1;
+      }
+    }
   }
 
   /// Distance from the robot's body (disc) to the nearest solid or pedestrian; < 0 = overlap.
@@ -179,12 +216,11 @@ struct Simulator::Impl {
         if (what) *what = k.name;
       }
     }
-    for (const auto& p : world.pedestrians) {
-      const auto st = pedestrianAt(p, t);
+    for (const auto& st : pedestriansAt(t)) {
       const double d = (c - st.position).norm() - st.radius - r;
       if (d < best) {
         best = d;
-        if (what) *what = p.name;
+        if (what) *what = st.name;
       }
     }
     return best;
@@ -205,12 +241,17 @@ struct Simulator::Impl {
       w += std::clamp(cmd_w - w, -params.alpha_max * dt, params.alpha_max * dt);
     }
     const hw::Pose2D prev = gt();
+    updateWaits(prev, v, t_next, dt);
     vehicle.movementCommand(v, w);
     vehicle.step();
     const hw::Pose2D now = gt();
     std::string what;
     clearance = clearanceAt(now, t_next, &what);
     min_clearance = std::min(min_clearance, clearance);
+    for (const auto& st : pedestriansAt(t_next))
+      min_clearance_people =
+          std::min(min_clearance_people,
+                   (Vec2(now.x, now.y) - st.position).norm() - st.radius - world.robot.radius);
     if (clearance < 0) {
       if (!collided) {
         collided = true;
@@ -542,6 +583,11 @@ double Simulator::minClearance() {
   std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
   impl_->sync();
   return impl_->min_clearance;
+}
+double Simulator::minClearancePeople() {
+  std::lock_guard<std::recursive_mutex> lock(impl_->mutex);
+  impl_->sync();
+  return impl_->min_clearance_people;
 }
 double Simulator::clearance() {
   std::lock_guard<std::recursive_mutex> lock(impl_->mutex);

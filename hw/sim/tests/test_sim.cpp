@@ -1004,3 +1004,48 @@ TEST(WorldValidation, HugeValuesAreQuotedInPart) {
   EXPECT_NE(m.find("start"), std::string::npos) << m;
   EXPECT_LT(m.size(), 400u);
 }
+
+// A pedestrian coming up behind the robot waits short of it (the robot does not see behind
+// it); from the front it walks on into it. Off, it walks into it from behind too.
+TEST(Pedestrians, WaitBehindTheRobotButNotInFrontOfIt) {
+  sim::World w = boxWorld(20, 6);
+  w.start = {6.0, 3.0, 0.0};  // facing +x; the walker comes along y = 3 from x = 1
+  sim::Pedestrian p;
+  p.name = "walker";
+  p.path = {{1.0, 3.0}, {15.0, 3.0}};
+  p.speed = 0.5;
+  p.radius = 0.25;
+  w.pedestrians = {p};
+  const double reach = p.radius + w.robot.radius;
+  {
+    sim::Simulator s(w, exactParams());
+    s.clock()->sleepUntil(20.0);  // it would be at x = 11 by now
+    EXPECT_FALSE(s.collided());
+    const auto st = s.pedestrians()[0];
+    EXPECT_NEAR(6.0 - st.position.x() - reach, 0.5, 0.02);  // waiting 0.5 m short
+    EXPECT_EQ(st.velocity.norm(), 0.0);
+    EXPECT_NEAR(s.minClearancePeople(), 0.5, 0.02);
+    // The robot drives on: the walker follows, and never closes in on it.
+    s.base().command(0.3, 0.0);
+    s.clock()->sleepUntil(26.0);
+    EXPECT_FALSE(s.collided());
+    EXPECT_GT(s.pedestrians()[0].position.x(), st.position.x() + 1.0);
+    EXPECT_GE(s.minClearancePeople(), 0.45);
+  }
+  {
+    sim::SimParams off = exactParams();
+    off.pedestrian_keep_behind_m = 0;
+    sim::Simulator s(w, off);
+    s.clock()->sleepUntil(20.0);
+    EXPECT_TRUE(s.collided());
+    EXPECT_EQ(s.collisionWith(), "walker");
+    EXPECT_LT(s.minClearancePeople(), 0.0);
+  }
+  {
+    sim::World front = w;
+    front.start = {6.0, 3.0, M_PI};  // facing the walker: it walks on
+    sim::Simulator s(front, exactParams());
+    s.clock()->sleepUntil(20.0);
+    EXPECT_TRUE(s.collided());
+  }
+}

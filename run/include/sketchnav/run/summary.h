@@ -19,9 +19,10 @@ struct RunSummary {
   std::string failure;     // judge.h failureCode: "" on success (and from a summary older than it)
   double time_s = 0;       // [s] on the run's clock (simulated time in simulation)
   double wall_time_s = 0;  // [s]
-  double real_time_factor = 0;   // time_s / wall_time_s
-  double path_length_m = 0;      // [m] the true distance in simulation, else odometry's
-  double min_clearance_m = NAN;  // [m] simulation only
+  double real_time_factor = 0;          // time_s / wall_time_s
+  double path_length_m = 0;             // [m] the true distance in simulation, else odometry's
+  double min_clearance_m = NAN;         // [m] simulation only
+  double min_clearance_people_m = NAN;  // [m] to a pedestrian's body (simulation, with people)
   double deviation_mean_m = NAN, deviation_max_m = NAN;  // [m] from the sketched path
   /// Against ground truth (simulation only, "diagnostics"): how far the odometry ended off
   /// [m], where the executive finally put the goal [m], and how far the drawing alone puts it

@@ -55,6 +55,13 @@ struct SimParams {
   double odom_drift = 0.01;          // [rad/m] systematic heading drift per metre driven
   // Range sensors
   double range_noise_scale = 1.0;  // multiplies the world's laser/sonar noise_std (0 = exact)
+  // Pedestrians follow their paths whatever the robot does, with one exception: someone who
+  // comes up behind the robot (it in their way ahead of them, its back towards them, not
+  // driving at them) waits pedestrian_keep_behind_m [m] short of it until it moves on, as
+  // people do behind someone standing in a corridor. The robot's sensors do not see behind
+  // it; coming at it from the front or the side, people walk on (the robot must keep out of
+  // their way). 0 = they walk into it from behind too.
+  double pedestrian_keep_behind_m = 0.5;
   // Randomness
   std::uint64_t seed = 1;
   // Trajectory recording
@@ -77,6 +84,7 @@ struct SimParams {
     b("odom_scale_error", odom_scale_error);
     b("odom_drift", odom_drift);
     b("range_noise_scale", range_noise_scale);
+    b("pedestrian_keep_behind_m", pedestrian_keep_behind_m);
     b("seed", seed);
     b("record_period", record_period);
   }
@@ -91,7 +99,8 @@ struct PedestrianState {
   double radius = 0.25;            // [m]
 };
 
-/// Where pedestrian `p` is at simulated time `t` (its position is a function of time only).
+/// Where pedestrian `p` is at simulated time `t` when it has not waited (a function of time
+/// only; Simulator::pedestrians() gives where each is, waits included).
 PedestrianState pedestrianAt(const Pedestrian& p, double t);
 
 struct TrajectorySample {
@@ -136,6 +145,7 @@ class Simulator {
   bool collided();
   std::string collisionWith();  // name of what was hit ("" when none)
   double minClearance();        // [m] closest approach of the body to anything so far
+  double minClearancePeople();  // [m] closest approach of the body to a pedestrian's (inf: none)
   double clearance();           // [m] current distance from the body to the nearest thing
   std::vector<PedestrianState> pedestrians();
   const World& world() const { return world_; }
