@@ -37,6 +37,7 @@
 #include "sketchnav/nav/sections.h"
 #include "sketchnav/run/judge.h"
 #include "sketchnav/run/run_folder.h"
+#include "sketchnav/run/summary.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
 #include "sketchnav/sim/simulator.h"
@@ -580,16 +581,19 @@ Json runNavigation(const RunOptions& o) {
   const double wall_s = std::chrono::duration<double>(wall::now() - w0).count();
 
   // --- summary ------------------------------------------------------------------------------
+  // The figures its users read back are typed (RunSummary, written by its toJson at the end);
+  // the rest is added here.
   Json s;
+  RunSummary fig;
   bool success = es.status == nav::RunStatus::Succeeded;
   std::string reason = es.reason;
   s["mode"] = replay ? "replay" : hardware ? "hardware" : "sim";
   if (!o.record.empty()) s["record"] = o.record;
-  s["time_s"] = es.time_s;
-  s["wall_time_s"] = wall_s;
-  s["real_time_factor"] = wall_s > 0 ? es.time_s / wall_s : 0.0;
+  fig.time_s = es.time_s;
+  fig.wall_time_s = wall_s;
+  fig.real_time_factor = wall_s > 0 ? es.time_s / wall_s : 0.0;
   s["odom_path_m"] = es.odom_path_m;
-  s["path_length_m"] = es.odom_path_m;
+  fig.path_length_m = es.odom_path_m;
   s["seed"] = o.seed;
   s["world"] = hardware ? "" : world_name;
   s["sketch"] = sketch_path;
@@ -625,14 +629,11 @@ Json runNavigation(const RunOptions& o) {
   s["executive"] = {{"status", nav::toString(es.status)},
                     {"failure", nav::toString(es.failure)},
                     {"reason", es.reason}};
-  s["executive_success"] = es.status == nav::RunStatus::Succeeded;
+  fig.executive_success = es.status == nav::RunStatus::Succeeded;
   // Every setting the run used, as --config takes them (the simulator's as it ran: its seed is
   // the run's --seed).
   if (simr) rs.sim = simr->params();
   s["settings"] = runSettingsJson(rs, simr != nullptr);
-  s["min_clearance_m"] = nullptr;
-  s["min_clearance_people_m"] = nullptr;
-  s["deviation_m"] = nullptr;
 
   RouteToWorld r2w;
   r2w.route_start = route.start_m;
@@ -652,31 +653,28 @@ Json runNavigation(const RunOptions& o) {
     if (collided) s["collision_with"] = simr->collisionWith();
     s["at_goal"] = at_goal;
     s["distance_to_goal_m"] = to_goal;
-    s["min_clearance_m"] = simr->minClearance();
-    const double people = simr->minClearancePeople();
-    s["min_clearance_people_m"] = std::isfinite(people) ? Json(people) : Json(nullptr);
-    s["path_length_m"] = simr->stats().distance;
+    fig.min_clearance_m = simr->minClearance();
+    const double people = simr->minClearancePeople();  // inf: no pedestrians
+    fig.min_clearance_people_m = std::isfinite(people) ? people : NAN;
+    fig.path_length_m = simr->stats().distance;
     s["frames_rendered"] = simr->stats().frames_rendered;
     // Where the robot's belief went wrong, against ground truth: its odometry (the executive's
     // pose, scan-matched) and where the re-fitted sketch put the goal. The distance to the goal
     // is roughly their sum, so a short stop shows which one to work on.
     if (!observer.odom.empty()) {
       const hw::Pose2D o = observer.odom.back();
-      Json d;
+      RunSummary::Diagnostics d;
       const hw::Pose2D& ot = observer.last_truth;
-      d["odometry_error_m"] =
-          (odomToWorld(w.start, {o.x, o.y}) - Eigen::Vector2d(ot.x, ot.y)).norm();
-      d["odometry_heading_error_deg"] =
-          wrapAngle(w.start.theta + o.theta - ot.theta) * 180.0 / M_PI;
+      d.odometry_error_m = (odomToWorld(w.start, {o.x, o.y}) - Eigen::Vector2d(ot.x, ot.y)).norm();
+      d.odometry_heading_error_deg = wrapAngle(w.start.theta + o.theta - ot.theta) * 180.0 / M_PI;
       if (observer.goal_odom) {
         const Eigen::Vector2d g = odomToWorld(w.start, *observer.goal_odom);
-        d["goal_estimate_error_m"] = (g - w.goal.centre).norm();
-        d["goal_estimate_world"] = {g.x(), g.y()};
+        d.goal_estimate_error_m = (g - w.goal.centre).norm();
+        d.goal_estimate_world = std::array<double, 2>{g.x(), g.y()};
       }
       // The drawing's own share: a goal error near this one is the sketch's, not the robot's.
-      if (const auto e = sketchGoalErrorM(w, route, settings.exec.fit_outlier_m))
-        d["sketch_goal_error_m"] = *e;
-      s["diagnostics"] = d;
+      d.sketch_goal_error_m = sketchGoalErrorM(w, route, settings.exec.fit_outlier_m);
+      fig.diagnostics = d;
     }
     s["render_s"] = simr->stats().render_seconds;
     // Ground truth decides success in simulation (doc/navigation.md): the robot's centre in
@@ -700,11 +698,13 @@ Json runNavigation(const RunOptions& o) {
       sum += d;
       mx = std::max(mx, d);
     }
-    s["deviation_m"] = {{"mean", sum / traj.size()}, {"max", mx}};
+    fig.deviation_mean_m = sum / traj.size();
+    fig.deviation_max_m = mx;
   }
-  s["success"] = success;
-  s["reason"] = reason;
-  s["failure"] = failureCode(success, s.value("collided", false), es);
+  fig.success = success;
+  fig.reason = reason;
+  fig.failure = failureCode(success, s.value("collided", false), es);
+  s.update(fig.toJson());
 
   if (!o.out_dir.empty()) {
     // Whole or not at all (temp file + rename): a run killed while writing it leaves no

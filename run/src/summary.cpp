@@ -33,12 +33,47 @@ RunSummary RunSummary::fromJson(const Json& s) {
     const Json& d = s["diagnostics"];
     Diagnostics dg;
     dg.odometry_error_m = number(d, "odometry_error_m", 0);
+    dg.odometry_heading_error_deg = number(d, "odometry_heading_error_deg", 0);
+    if (d.contains("goal_estimate_world") && d["goal_estimate_world"].is_array() &&
+        d["goal_estimate_world"].size() == 2 && d["goal_estimate_world"][0].is_number() &&
+        d["goal_estimate_world"][1].is_number())
+      dg.goal_estimate_world = {d["goal_estimate_world"][0].get<double>(),
+                                d["goal_estimate_world"][1].get<double>()};
     for (auto [key, field] : {std::pair{"goal_estimate_error_m", &dg.goal_estimate_error_m},
                               std::pair{"sketch_goal_error_m", &dg.sketch_goal_error_m}})
       if (d.contains(key) && d[key].is_number()) *field = d[key].get<double>();
     r.diagnostics = dg;
   }
   return r;
+}
+
+Json RunSummary::toJson() const {
+  const auto orNull = [](double x) { return std::isnan(x) ? Json(nullptr) : Json(x); };
+  Json s = {{"success", success},
+            {"executive_success", executive_success},
+            {"reason", reason},
+            {"failure", failure},
+            {"time_s", time_s},
+            {"wall_time_s", wall_time_s},
+            {"real_time_factor", real_time_factor},
+            {"path_length_m", path_length_m},
+            {"min_clearance_m", orNull(min_clearance_m)},
+            {"min_clearance_people_m", orNull(min_clearance_people_m)}};
+  s["deviation_m"] =
+      std::isnan(deviation_mean_m) && std::isnan(deviation_max_m)
+          ? Json(nullptr)
+          : Json{{"mean", orNull(deviation_mean_m)}, {"max", orNull(deviation_max_m)}};
+  if (diagnostics) {
+    const Diagnostics& dg = *diagnostics;
+    Json d = {{"odometry_error_m", dg.odometry_error_m},
+              {"odometry_heading_error_deg", dg.odometry_heading_error_deg}};
+    if (dg.goal_estimate_error_m) d["goal_estimate_error_m"] = *dg.goal_estimate_error_m;
+    if (dg.goal_estimate_world)
+      d["goal_estimate_world"] = {(*dg.goal_estimate_world)[0], (*dg.goal_estimate_world)[1]};
+    if (dg.sketch_goal_error_m) d["sketch_goal_error_m"] = *dg.sketch_goal_error_m;
+    s["diagnostics"] = d;
+  }
+  return s;
 }
 
 }  // namespace sketchnav::run

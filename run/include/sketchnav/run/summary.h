@@ -1,8 +1,9 @@
 #pragma once
 // A run's summary, typed: the figures of summary.json (run.h runNavigation) that the run's
 // users read back (`sketchnav run`'s report, the scenario runner's results, the experiments
-// report), each read once here, by type, rather than by key wherever it is used. summary.json
-// itself stays the complete record (RunSummary::json).
+// report), written (toJson) and read (fromJson) here, by type, rather than by key wherever
+// they are used. summary.json itself stays the complete record (RunSummary::json).
+#include <array>
 #include <cmath>
 #include <optional>
 #include <string>
@@ -29,7 +30,9 @@ struct RunSummary {
   /// [m] (judge.h sketchGoalErrorM); each absent when the run could not tell.
   struct Diagnostics {
     double odometry_error_m = 0;
+    double odometry_heading_error_deg = 0;  // [deg] the final odometry heading's error
     std::optional<double> goal_estimate_error_m;
+    std::optional<std::array<double, 2>> goal_estimate_world;  // [m] where it put the goal
     std::optional<double> sketch_goal_error_m;
   };
   std::optional<Diagnostics> diagnostics;
@@ -40,6 +43,11 @@ struct RunSummary {
   /// Json's type_error (a summary.json that is not this program's), as does a summary that is
   /// not an object.
   static RunSummary fromJson(const Json& summary);
+  /// The figures above as summary.json holds them (a figure the run could not measure, NaN,
+  /// is null; no diagnostics, no key); `json` is not part of it: the rest of summary.json
+  /// (settings, landmarks, timing, ...) is the run's to add. fromJson(toJson()) gives the
+  /// figures back.
+  Json toJson() const;
 };
 
 }  // namespace sketchnav::run
