@@ -377,15 +377,23 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
     double best = 1e300, best_free = 0;
     bool backwards = false;
     const double v_back = P.lane_reverse_speed;
+    // A way out along robot-frame direction `a` (every 5 degrees round): how steeply it leaves
+    // the lane (`away`, the sine of its angle to the axis) and how far it is free (`free`);
+    // false when it is not steep enough or has no room for the next few centimetres. Ties go
+    // to the route's direction (tie()).
+    const auto wayOut = [&](double a, double& away, double& free) {
+      away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
+      if (away < steep - 1e-9) return false;
+      free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
+      return free >= P.min_clearance_m + 0.02;
+    };
+    const auto tie = [&](double a) { return 0.01 * std::abs(wrapAngle(a - target_bearing)); };
     for (int i = -35; i <= 36; ++i) {
       const double a = i * 5 * M_PI / 180;
-      const double away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
-      if (away < steep - 1e-9) continue;
-      const double free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
-      if (free < P.min_clearance_m + 0.02) continue;
-      const double tie = 0.01 * std::abs(wrapAngle(a - target_bearing));
+      double away, free;
+      if (!wayOut(a, away, free)) continue;
       const double t =
-          std::abs(a) / P.max_turn_rate + togo / (std::max(v_nominal, 0.05) * away) + tie;
+          std::abs(a) / P.max_turn_rate + togo / (std::max(v_nominal, 0.05) * away) + tie(a);
       if (t < best) best = t, dir = a, best_free = free, steer = true;
     }
     // Backwards only where every forward way out means turning on the spot first (more than
@@ -398,13 +406,10 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
     if (v_back > 0 && (!steer || std::abs(dir) > 1.0) && arrive_s > 0.3 && now_off >= 0) {
       for (int i = -35; i <= 36; ++i) {
         const double a = i * 5 * M_PI / 180;
-        const double away = std::cos(a) * nr.x() + std::sin(a) * nr.y();
-        if (away < steep - 1e-9 || std::abs(a) <= M_PI / 2) continue;
-        const double free = corridorFree(pts, a, P.robot_radius_m, P.max_range_m);
-        if (free < P.min_clearance_m + 0.02) continue;
+        double away, free;
+        if (std::abs(a) <= M_PI / 2 || !wayOut(a, away, free)) continue;
         const double e = wrapAngle(a - M_PI);  // heading change for the back to face `a`
-        const double tb = std::abs(e) / P.max_turn_rate + togo / (v_back * away) +
-                          0.01 * std::abs(wrapAngle(a - target_bearing));
+        const double tb = std::abs(e) / P.max_turn_rate + togo / (v_back * away) + tie(a);
         if (tb < best && sweptSeenFree(a, togo + P.min_clearance_m))
           best = tb, dir = a, best_free = free, steer = true, backwards = true;
       }
@@ -443,7 +448,6 @@ void ObstacleAvoider::laneEscape(const std::vector<std::pair<double, double>>& p
   }
   out.direction = dir;
   out.w = steer ? P.k_heading * dir : 0.0;
-  out.v = v;
   out.v = v;
 }
 
