@@ -41,6 +41,8 @@ void SimParams::validate() const {
   require(range_noise_scale >= 0 && range_noise_scale < 100, "sim.range_noise_scale",
           "must be in [0, 100)");
   require(record_period >= 0, "sim.record_period", "must be >= 0");
+  require(pedestrian_keep_behind_m >= 0 && pedestrian_keep_behind_m <= 5,
+          "sim.pedestrian_keep_behind_m", "must be in [0, 5] m (0 = off)");
 }
 
 namespace {

@@ -248,6 +248,14 @@ TEST(SimParams, ValidateNamesTheField) {
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("sim.substep"), std::string::npos);
   }
+  sim::SimParams q;
+  q.pedestrian_keep_behind_m = std::nan("");
+  try {
+    q.validate();
+    FAIL() << "no error";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("sim.pedestrian_keep_behind_m"), std::string::npos);
+  }
 }
 
 // ---------------------------------------------------------------- rendering
