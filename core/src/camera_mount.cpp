@@ -26,9 +26,8 @@ const std::vector<std::pair<std::string, std::string>>& cameraMountRenames() {
 
 CameraMount cameraMountFrom(const Config& config) {
   for (const auto& [old_key, new_key] : cameraMountRenames())
-    if (config.has(old_key))
-      throw InputError(config.origin(old_key) + ": setting '" + old_key + "' is now '" + new_key +
-                       "' (the camera mount is one setting group, robot.camera.*)");
+    rejectRenamed(config, old_key, new_key,
+                  "the camera mount is one setting group, robot.camera.*");
   CameraMount m;
   applyConfig(m, config, cameraMountPrefix());
   return m;

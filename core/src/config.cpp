@@ -183,6 +183,13 @@ bool wholeNumberWithin(const Json& v, long double lo, long double hi) {
 }
 }  // namespace detail
 
+void rejectRenamed(const Config& config, const std::string& old_key, const std::string& new_key,
+                   const std::string& why) {
+  if (config.has(old_key))
+    throw InputError(config.origin(old_key) + ": setting '" + old_key + "' is now '" + new_key +
+                     "' (" + why + ")");
+}
+
 void require(bool ok, const std::string& field, const std::string& why) {
   if (!ok) throw InputError("invalid setting '" + field + "': " + why);
 }

@@ -171,10 +171,8 @@ struct Cruise {
 }  // namespace
 
 TurnLawParams turnLawParamsFrom(const Config& config) {
-  if (config.has("servo.v_forward"))
-    throw InputError(config.origin("servo.v_forward") +
-                     ": setting 'servo.v_forward' is now 'nav.v_cruise' (servoing keeps the "
-                     "robot's cruise speed)");
+  rejectRenamed(config, "servo.v_forward", "nav.v_cruise",
+                "servoing keeps the robot's cruise speed");
   TurnLawParams p;
   applyConfig(p, config, "servo");
   p.setCamera(cameraMountFrom(config));

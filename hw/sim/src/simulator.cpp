@@ -200,7 +200,9 @@ struct Simulator::Impl {
   }
 
   /// Distance from the robot's body (disc) to the nearest solid or pedestrian; < 0 = overlap.
-  double clearanceAt(const hw::Pose2D& pose, double t, std::string* what) const {
+  /// `people` (when given): lowered to the distance to the nearest pedestrian's body.
+  double clearanceAt(const hw::Pose2D& pose, double t, std::string* what,
+                     double* people = nullptr) const {
     const Vec2 c(pose.x, pose.y);
     const double r = world.robot.radius;
     double best = geom::kInf;
@@ -220,6 +222,7 @@ struct Simulator::Impl {
     }
     for (const auto& st : pedestriansAt(t)) {
       const double d = (c - st.position).norm() - st.radius - r;
+      if (people) *people = std::min(*people, d);
       if (d < best) {
         best = d;
         if (what) *what = st.name;
@@ -248,12 +251,8 @@ struct Simulator::Impl {
     vehicle.step();
     const hw::Pose2D now = gt();
     std::string what;
-    clearance = clearanceAt(now, t_next, &what);
+    clearance = clearanceAt(now, t_next, &what, &min_clearance_people);
     min_clearance = std::min(min_clearance, clearance);
-    for (const auto& st : pedestriansAt(t_next))
-      min_clearance_people =
-          std::min(min_clearance_people,
-                   (Vec2(now.x, now.y) - st.position).norm() - st.radius - world.robot.radius);
     if (clearance < 0) {
       if (!collided) {
         collided = true;

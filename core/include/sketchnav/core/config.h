@@ -148,4 +148,9 @@ Json paramsToJson(const P& params) {
 /// Helper for validate(): throws InputError "<owner>.<field> = <value>: <why>" when !ok.
 void require(bool ok, const std::string& field, const std::string& why);
 
+/// A setting that has a new name: throws InputError "<origin>: setting '<old_key>' is now
+/// '<new_key>' (<why>)" when `config` holds `old_key`.
+void rejectRenamed(const Config& config, const std::string& old_key, const std::string& new_key,
+                   const std::string& why);
+
 }  // namespace sketchnav
