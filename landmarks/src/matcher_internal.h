@@ -79,6 +79,7 @@ struct Votes {
   // only rows that can plausibly match that class's photos, so verification searches these.
   std::vector<std::vector<int>> class_rows;
   std::vector<std::vector<Corr>> photo_corr;  // per database photo
+  std::vector<int> row_class;                 // per window row, the class it votes for, -1 = none
 };
 Votes computeVotes(const LandmarkModel& model, const FrameFeatures& frame, const WindowQuery& q,
                    int knn, double class_ratio, int checks, double colour_tolerance);

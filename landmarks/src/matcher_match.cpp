@@ -261,6 +261,7 @@ Votes computeVotes(const LandmarkModel& model, const FrameFeatures& frame, const
   v.class_votes.assign(model.classes().size(), 0);
   v.photo_corr.resize(model.photos().size());
   v.class_rows.resize(model.classes().size());
+  v.row_class.assign(q.descriptors.rows, -1);
   if (q.descriptors.rows == 0 || model.photos().empty()) return v;
   cv::Mat nn, d2;
   model.knnAll(q.descriptors, knn, checks, nn, d2);
@@ -298,6 +299,7 @@ Votes computeVotes(const LandmarkModel& model, const FrameFeatures& frame, const
       }
     if (!(dist[0] < r2 * other)) continue;
     ++v.class_votes[c1];
+    v.row_class[i] = c1;
     seen_photo.clear();
     for (size_t k = 0; k < owner.size(); ++k) {
       if (!(dist[k] < r2 * other)) break;

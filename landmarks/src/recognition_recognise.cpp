@@ -351,6 +351,18 @@ std::vector<std::vector<Recognition>> recogniseWindows(const LandmarkModel& mode
   return out;
 }
 
+std::vector<int> keypointVotes(const LandmarkModel& model, const FrameFeatures& frame,
+                               const RecognitionParams& p) {
+  const auto idx = detail::keypointsInWindow(frame, cv::Rect());
+  std::vector<int> out(frame.features.keypoints.size(), -1);
+  if (idx.empty()) return out;
+  const auto q = detail::makeQuery(model, frame, idx);
+  const detail::Votes v = detail::computeVotes(model, frame, q, p.knn, p.class_ratio,
+                                               p.search_checks, p.match.colour_tolerance);
+  for (size_t r = 0; r < idx.size(); ++r) out[idx[r]] = v.row_class[r];
+  return out;
+}
+
 std::vector<Recognition> recognise(const LandmarkModel& model, const cv::Mat& bgr,
                                    const std::vector<cv::Rect>& windows, int top_k,
                                    const RecognitionParams& p) {

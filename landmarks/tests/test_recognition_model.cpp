@@ -1,5 +1,6 @@
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
@@ -230,6 +231,38 @@ TEST_F(TinyModel, WindowsRestrictTheSearch) {
   EXPECT_EQ(per[1][0].class_name, "class2");
   EXPECT_FALSE(per[0][0].rejected);
   EXPECT_EQ(per[1][0].window, cv::Rect(320, 0, 320, 240));
+}
+
+// Per keypoint, the class it votes for: over each object's half of the frame mostly that
+// object's class and hardly ever the other's, and the same counts as recogniseWindows' votes.
+TEST_F(TinyModel, KeypointVotesSayWhichObjectEachKeypointBelongsTo) {
+  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 8001, 5)
+      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
+  test::randomView(test::texturedImage(240, 180, 1002), 320, 240, 8002, 5)
+      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
+  const FrameFeatures f = computeFrameFeatures(*model_, frame);
+  const RecognitionParams p;
+  const std::vector<int> votes = keypointVotes(*model_, f, p);
+  ASSERT_EQ(votes.size(), f.features.keypoints.size());
+  const int c0 = model_->classId("class0"), c2 = model_->classId("class2");
+  int left[2] = {0, 0}, right[2] = {0, 0};  // votes for class0, class2
+  for (size_t i = 0; i < votes.size(); ++i) {
+    int* side = f.features.keypoints[i].pt.x < 320 ? left : right;
+    side[0] += votes[i] == c0;
+    side[1] += votes[i] == c2;
+  }
+  EXPECT_GE(left[0], 10);
+  EXPECT_GE(right[1], 10);
+  EXPECT_LE(left[1], left[0] / 5);
+  EXPECT_LE(right[0], right[1] / 5);
+  // The whole frame's recognition counts the same votes.
+  const auto whole = recogniseWindows(*model_, f, {}, 3, p);
+  ASSERT_FALSE(whole.empty());
+  for (const auto& r : whole[0]) {
+    const int c = model_->classId(r.class_name);
+    EXPECT_EQ(r.votes, static_cast<int>(std::count(votes.begin(), votes.end(), c))) << r.class_name;
+  }
 }
 
 TEST_F(TinyModel, SaveLoadRoundTripGivesTheSameAnswers) {

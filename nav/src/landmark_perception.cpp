@@ -286,9 +286,23 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
   if (P.recognise_windows <= 0 || windows.empty()) return out;
   std::vector<int> ids;
   for (const auto& c : classes) ids.push_back(model.classId(c));
-  std::vector<std::pair<float, int>> ranked;
-  for (int i = 0; i < static_cast<int>(windows.size()); ++i)
-    ranked.push_back({bowScore(model, feats, windows[i], ids), i});
+  // Per window: the looked-for classes' nearest-neighbour votes among its keypoints, weighed by
+  // how much of the window votes for them (votes / sqrt(keypoints)), then the BoW score.
+  std::vector<int> voted;
+  if (P.rank_by_votes) voted = landmarks::keypointVotes(model, feats, P.recognition);
+  std::vector<std::pair<std::pair<float, float>, int>> ranked;
+  for (int i = 0; i < static_cast<int>(windows.size()); ++i) {
+    float vote_score = 0;
+    if (P.rank_by_votes) {
+      const auto in = keypointsIn(feats, windows[i]);
+      int v = 0;
+      for (int k : in)
+        if (std::find(ids.begin(), ids.end(), voted[k]) != ids.end()) ++v;
+      if (!in.empty())
+        vote_score = static_cast<float>(v / std::sqrt(static_cast<double>(in.size())));
+    }
+    ranked.push_back({{vote_score, bowScore(model, feats, windows[i], ids)}, i});
+  }
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   const cv::Rect frame_rect(0, 0, img.cols, img.rows);

@@ -193,6 +193,13 @@ std::vector<std::vector<Recognition>> recogniseWindows(const LandmarkModel& mode
                                                        const std::vector<cv::Rect>& windows,
                                                        int top_k, const RecognitionParams& p);
 
+/// The class each keypoint of `frame` votes for in recogniseWindows()'s nearest-neighbour vote
+/// (the ratio test between classes and the colour gate of `p`), -1 where it votes for none: one
+/// database search for the whole frame, so that windows can be ranked by the votes they hold
+/// for a class before any of them is recognised.
+std::vector<int> keypointVotes(const LandmarkModel& model, const FrameFeatures& frame,
+                               const RecognitionParams& p);
+
 /// Candidates of all windows merged, one entry per class (from its best window), best first,
 /// at most top_k: verified classes first, then colour-rescued ones (geometry is the stronger
 /// evidence), then unverified candidates marked rejected.

@@ -139,16 +139,23 @@ struct PerceptionParams {
   int fovea_max_features = 1000;   // strongest keypoints kept in the crop (0 = all)
   int fovea_max_looks = 1;         // second looks per frame at most, in hint order (the
                                    // executive lists the landmark it servos on first)
-  // Recognition in the loop (the paper's pipeline): windows are ranked by the looked-for
-  // classes' BoW score (the SVM decision on the window's visual words), and the best
-  // recognise_windows of them are recognised (landmarks::recogniseWindows: votes, BoW, colour
-  // layout and verification) on a crop of the full-resolution frame scaled to window_side px.
-  // A window whose answer is a looked-for class is a detection even when no database photo
-  // reaches min_inliers (a view the photos do not show closely): its position then comes from a
-  // match needing only position_min_inliers; without one it gives no detection (a window's
-  // centre is no position). The foveal second look is recognised the same way. 0 = matching
-  // alone.
+  // Recognition in the loop (the paper's pipeline): windows are ranked for the looked-for
+  // classes (rank_by_votes, below), and the best recognise_windows of them are recognised
+  // (landmarks::recogniseWindows: votes, BoW, colour layout and verification) on a crop of the
+  // full-resolution frame scaled to window_side px. A window whose answer is a looked-for class is
+  // a detection even when no database photo reaches min_inliers (a view the photos do not show
+  // closely): its position then comes from a match needing only position_min_inliers; without one
+  // it gives no detection (a window's centre is no position). The foveal second look is recognised
+  // the same way. 0 = matching alone.
   int recognise_windows = 4;
+  // How the windows are ranked. true: by the frame keypoints inside a window that vote for a
+  // looked-for class (landmarks::keypointVotes: nearest database neighbour, ratio test between
+  // classes), divided by the square root of the window's keypoints (a window mostly made of the
+  // landmark outranks a larger one that also holds it), then by the BoW score. false: by the
+  // BoW score alone (the SVM decision on the window's visual words), which a window of a few
+  // dozen keypoints leaves close to chance. Evidence: doc/perception-benchmark.md "Ranking the
+  // windows by votes".
+  bool rank_by_votes = true;
   int position_min_inliers = 6;   // RANSAC inliers for the servo position of a recognised window
   int window_side = 256;          // [px] a recognised window is cropped and scaled to this side
   double window_margin = 0.15;    // crop margin round the window, fraction of its size per side
@@ -198,6 +205,7 @@ struct PerceptionParams {
     b("fovea_max_features", fovea_max_features);
     b("fovea_max_looks", fovea_max_looks);
     b("recognise_windows", recognise_windows);
+    b("rank_by_votes", rank_by_votes);
     b("position_min_inliers", position_min_inliers);
     b("window_side", window_side);
     b("window_margin", window_margin);
