@@ -53,6 +53,16 @@ class TinyModel : public ::testing::Test {
   static LandmarkModel* model_;
 };
 std::string TinyModel::root_;
+
+// class0's object in the left half of a 640 x 240 frame, class2's in the right half.
+cv::Mat twoObjects() {
+  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
+  test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 8001, 5)
+      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
+  test::randomView(test::texturedImage(240, 180, 1002), 320, 240, 8002, 5)
+      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
+  return frame;
+}
 LandmarkModel* TinyModel::model_ = nullptr;
 
 }  // namespace
@@ -216,12 +226,7 @@ TEST_F(TinyModel, InlierEvidenceIsReportedBelowMinInliers) {
 
 TEST_F(TinyModel, WindowsRestrictTheSearch) {
   // Two objects side by side; each window recognises its own.
-  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
-  test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 8001, 5)
-      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
-  test::randomView(test::texturedImage(240, 180, 1002), 320, 240, 8002, 5)
-      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
-  const FrameFeatures f = computeFrameFeatures(*model_, frame);
+  const FrameFeatures f = computeFrameFeatures(*model_, twoObjects());
   const auto per = recogniseWindows(
       *model_, f, {cv::Rect(0, 0, 320, 240), cv::Rect(320, 0, 320, 240)}, 1, RecognitionParams{});
   ASSERT_EQ(per.size(), 2u);
@@ -236,12 +241,7 @@ TEST_F(TinyModel, WindowsRestrictTheSearch) {
 // Per keypoint, the class it votes for: over each object's half of the frame mostly that
 // object's class and hardly ever the other's, and the same counts as recogniseWindows' votes.
 TEST_F(TinyModel, KeypointVotesSayWhichObjectEachKeypointBelongsTo) {
-  cv::Mat frame(240, 640, CV_8UC3, cv::Scalar(128, 128, 128));
-  test::randomView(test::texturedImage(240, 180, 1000), 320, 240, 8001, 5)
-      .copyTo(frame(cv::Rect(0, 0, 320, 240)));
-  test::randomView(test::texturedImage(240, 180, 1002), 320, 240, 8002, 5)
-      .copyTo(frame(cv::Rect(320, 0, 320, 240)));
-  const FrameFeatures f = computeFrameFeatures(*model_, frame);
+  const FrameFeatures f = computeFrameFeatures(*model_, twoObjects());
   const RecognitionParams p;
   const std::vector<int> votes = keypointVotes(*model_, f, p);
   ASSERT_EQ(votes.size(), f.features.keypoints.size());
