@@ -53,6 +53,7 @@ class TinyModel : public ::testing::Test {
   static LandmarkModel* model_;
 };
 std::string TinyModel::root_;
+LandmarkModel* TinyModel::model_ = nullptr;
 
 // class0's object in the left half of a 640 x 240 frame, class2's in the right half.
 cv::Mat twoObjects() {
@@ -63,7 +64,6 @@ cv::Mat twoObjects() {
       .copyTo(frame(cv::Rect(320, 0, 320, 240)));
   return frame;
 }
-LandmarkModel* TinyModel::model_ = nullptr;
 
 }  // namespace
 

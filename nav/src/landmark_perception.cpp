@@ -197,11 +197,11 @@ std::vector<int> keypointsIn(const landmarks::FrameFeatures& f, const cv::Rect& 
   return out;
 }
 
-// The best BoW decision value among `class_ids` for the words inside `box`.
+// The best BoW decision value among `class_ids` for the words of the keypoints `in` (a window's).
 float bowScore(const landmarks::LandmarkModel& model, const landmarks::FrameFeatures& f,
-               const cv::Rect& box, const std::vector<int>& class_ids) {
+               const std::vector<int>& in, const std::vector<int>& class_ids) {
   std::vector<int> words;
-  for (int i : keypointsIn(f, box))
+  for (int i : in)
     if (i < static_cast<int>(f.words.size())) words.push_back(f.words[i]);
   if (words.empty()) return -1e9f;
   const auto d =
@@ -284,24 +284,26 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
                                        int& recognised) {
   std::vector<Detection> out;
   if (P.recognise_windows <= 0 || windows.empty()) return out;
+  // The looked-for classes the model knows (a class it was not trained on has no votes, and
+  // its id -1 is what a keypoint voting for no class holds).
   std::vector<int> ids;
-  for (const auto& c : classes) ids.push_back(model.classId(c));
+  for (const auto& c : classes)
+    if (const int id = model.classId(c); id >= 0) ids.push_back(id);
   // Per window: the looked-for classes' nearest-neighbour votes among its keypoints, weighed by
   // how much of the window votes for them (votes / sqrt(keypoints)), then the BoW score.
   std::vector<int> voted;
   if (P.rank_by_votes) voted = landmarks::keypointVotes(model, feats, P.recognition);
   std::vector<std::pair<std::pair<float, float>, int>> ranked;
   for (int i = 0; i < static_cast<int>(windows.size()); ++i) {
+    const auto in = keypointsIn(feats, windows[i]);
     float vote_score = 0;
-    if (P.rank_by_votes) {
-      const auto in = keypointsIn(feats, windows[i]);
+    if (P.rank_by_votes && !in.empty()) {
       int v = 0;
       for (int k : in)
         if (std::find(ids.begin(), ids.end(), voted[k]) != ids.end()) ++v;
-      if (!in.empty())
-        vote_score = static_cast<float>(v / std::sqrt(static_cast<double>(in.size())));
+      vote_score = static_cast<float>(v / std::sqrt(static_cast<double>(in.size())));
     }
-    ranked.push_back({{vote_score, bowScore(model, feats, windows[i], ids)}, i});
+    ranked.push_back({{vote_score, bowScore(model, feats, in, ids)}, i});
   }
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
