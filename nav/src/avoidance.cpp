@@ -225,12 +225,16 @@ bool ObstacleAvoider::sweptSeenFree(double direction, double len) const {
   return true;
 }
 
-bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
-  const auto& P = params_;
-  const double speed = walker_.vel.norm();
-  if (!walker_.valid || !have_pose_ || P.lane_horizon_s <= 0 || speed < 0.2) return false;
-  const Eigen::Vector2d u = walker_.vel / speed;
-  const Eigen::Vector2d d = Eigen::Vector2d(pose_.x, pose_.y) - walker_.pos;
+namespace {
+// The lane test (AvoidParams: lane_horizon_s, both radii, lane_margin_m): whether a person at
+// `pos` walking at `vel` will pass within the lane's half-width of `robot`; then the unit
+// normal from the lane's axis towards the robot and the robot's offset from it [m].
+bool laneCovers(const AvoidParams& P, const Eigen::Vector2d& robot, const Eigen::Vector2d& pos,
+                const Eigen::Vector2d& vel, Eigen::Vector2d& normal, double& offset) {
+  const double speed = vel.norm();
+  if (P.lane_horizon_s <= 0 || speed < 0.2) return false;
+  const Eigen::Vector2d u = vel / speed;
+  const Eigen::Vector2d d = robot - pos;
   const double reach = P.robot_radius_m + P.person_radius_m;
   const double along = d.dot(u);
   // Passed (the robot is behind them, by the gap kept), or not reached within the horizon.
@@ -240,6 +244,21 @@ bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
   if (offset >= reach + P.lane_margin_m) return false;
   normal = offset > 1e-6 ? Eigen::Vector2d(lateral / offset) : Eigen::Vector2d(-u.y(), u.x());
   return true;
+}
+}  // namespace
+
+bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
+  if (!walker_.valid || !have_pose_) return false;
+  return laneCovers(params_, {pose_.x, pose_.y}, walker_.pos, walker_.vel, normal, offset);
+}
+
+bool ObstacleAvoider::walkerLaneCovers(const Eigen::Vector2d& robot,
+                                       const Eigen::Vector2d& position,
+                                       const Eigen::Vector2d& velocity) const {
+  if (velocity.dot(robot - position) <= 0) return false;  // walking away
+  Eigen::Vector2d n;
+  double off;
+  return laneCovers(params_, robot, position, velocity, n, off);
 }
 
 double ObstacleAvoider::capSpeed(const std::vector<hw::RangeScan>& scans, double v) const {

@@ -196,16 +196,17 @@ Command FinalLook::command(double bearing) const {
   return {0.0, w, turnOf(w)};
 }
 
-std::optional<double> Recovery::openDirection(const std::vector<std::pair<double, double>>& pts,
-                                              double half_width_m, double max_range_m,
-                                              double route_bearing) const {
+std::optional<double> Recovery::openDirection(
+    const std::vector<std::pair<double, double>>& pts, double half_width_m, double max_range_m,
+    double route_bearing, const std::function<bool(double, double)>& known_free) const {
   double best = -1e9, best_a = 0;
   for (int i = 0; i < 36; ++i) {
     const double a = wrapAngle(i * M_PI / 18);
     const double free = corridorFree(pts, a, half_width_m, max_range_m);
     const double score =
         std::min(free, p_.recover_m + 0.5) - 0.3 * std::abs(wrapAngle(a - route_bearing));
-    if (free >= 0.5 && score > best) best = score, best_a = a;
+    if (free >= 0.5 && score > best && (!known_free || known_free(a, 0.5)))
+      best = score, best_a = a;
   }
   if (best > -1e9) return best_a;
   return std::nullopt;

@@ -121,6 +121,7 @@ struct Writer {
       j["fix_ranges_used"] = f.ranges_used;
       j["fix_height_ranges"] = f.height_ranges;
       if (f.height_ranges > 0) j["fix_height_sigma_m"] = f.height_sigma_m;
+      j["fix_gated_ranges"] = f.gated_ranges;
       j["fix_ranges_dropped"] = f.ranges_dropped;
       json rays = json::array();
       for (const auto& q : f.sightings)

@@ -630,13 +630,29 @@ struct Executive::Impl {
         arb.propose(Behaviour::Dock, d->command);
       }
     }
+    const std::vector<Mover> walkers = movers.walkers();  // for the avoider and the side look
+    // A walker coming at the robot whose lane covers it: stepping out of the lane is the
+    // dodge's, which a recovery would keep from running (a robot driving clear of a corner
+    // drove into the lane of a person walking at it and stood there until they walked into it).
+    bool walker_lane = false;
+    for (const auto& m : walkers)
+      walker_lane |= avoider.walkerLaneCovers({pose.x, pose.y}, m.position, m.velocity);
+    if (walker_lane && !dev.ranges.empty()) {
+      if (recovery.active()) {
+        recovery.stop();
+        event(event::RecoverEnd{});
+      }
+      progress_checker.reset(pose, now);  // giving way is not being stuck
+    }
     // Stuck (ProgressChecker): drive clear towards the most open direction (Recovery).
-    if (!recovery.active() && !docking && !dev.ranges.empty() && progress_checker.due(now)) {
+    if (!recovery.active() && !docking && !dev.ranges.empty() && !walker_lane &&
+        progress_checker.due(now)) {
       const bool stuck = progress_checker.stuck(pose, now);
       if (stuck) {
         const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-        const auto dir =
-            recovery.openDirection(scanPoints(scans), hwid, s.avoid.max_range_m, target_bearing);
+        const auto dir = recovery.openDirection(
+            scanPoints(scans), hwid, s.avoid.max_range_m, target_bearing,
+            [&](double a, double len) { return avoider.sweptSeenFree(a, len); });
         if (dir) {
           const auto started = recovery.start(*dir, pose, now);
           if (avoider.active()) avoider.reset();
@@ -656,7 +672,6 @@ struct Executive::Impl {
     }
     double front = 0;
     bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
-    const std::vector<Mover> walkers = movers.walkers();  // for the avoider and the side look
     if (docking || recovery.active()) {
       endDetour(docking ? "docking" : "recovering");
       if (docking) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));

@@ -103,6 +103,7 @@ void LocateParams::validate() const {
   require(height_max_sigma_m > 0, "nav.locate.height_max_sigma_m", "must be > 0");
   require(height_min_sigma_m > 0, "nav.locate.height_min_sigma_m", "must be > 0");
   require(height_agree_m > 0, "nav.locate.height_agree_m", "must be > 0");
+  require(gated_confirm_sigma_m >= 0, "nav.locate.gated_confirm_sigma_m", "must be >= 0");
 }
 
 HeightRanges heightRanges(const std::vector<Sighting>& ss, const LocateParams& p) {
@@ -196,9 +197,33 @@ HeightRanges heightRanges(const std::vector<Sighting>& ss, const LocateParams& p
   return out;
 }
 
-LandmarkFix locateLandmark(const std::vector<Sighting>& sightings, const LocateParams& p) {
+namespace {
+// The sightings with the laser ranges the sketch's gate refused taken back when height
+// ranges confirm them (LocateParams::gated_confirm_sigma_m); counted in f.gated_ranges.
+std::vector<Sighting> withConfirmedRanges(std::vector<Sighting> ss, const LocateParams& p,
+                                          LandmarkFix& f) {
+  auto gated = [](const Sighting& s) { return s.range_m <= 0 && s.gated_range_m > 0; };
+  if (p.gated_confirm_sigma_m <= 0 || std::none_of(ss.begin(), ss.end(), gated)) return ss;
+  LocateParams loose = p;
+  loose.height_max_sigma_m = std::max(p.height_max_sigma_m, p.gated_confirm_sigma_m);
+  const HeightRanges hc = heightRanges(ss, loose);
+  if (hc.range_m.empty()) return ss;
+  std::vector<double> diff;
+  for (size_t i = 0; i < ss.size(); ++i)
+    if (gated(ss[i]) && hc.range_m[i] > 0) diff.push_back(ss[i].gated_range_m - hc.range_m[i]);
+  if (diff.empty()) return ss;
+  std::nth_element(diff.begin(), diff.begin() + diff.size() / 2, diff.end());
+  if (std::abs(diff[diff.size() / 2]) > std::max(p.height_agree_m, 2 * hc.sigma_m)) return ss;
+  for (auto& s : ss)
+    if (gated(s)) s.range_m = s.gated_range_m, ++f.gated_ranges;
+  return ss;
+}
+}  // namespace
+
+LandmarkFix locateLandmark(const std::vector<Sighting>& given, const LocateParams& p) {
   LandmarkFix f;
-  if (sightings.empty()) return f;
+  if (given.empty()) return f;
+  const std::vector<Sighting> sightings = withConfirmedRanges(given, p, f);
   // Height ranges in place of laser ranges that disagree with them (the laser hit what stands
   // behind or below the landmark), and for sightings the laser did not range at all.
   std::vector<double> range_sigma(sightings.size(), p.range_sigma_m);

@@ -187,6 +187,7 @@ std::optional<LandmarkTracker::Association> LandmarkTracker::associate(
     sg.elevation = d.elevation;
     sg.camera_along_m = camera_x_m * std::cos(d.bearing);
     sg.photo = d.photo;
+    if (range_dropped && cands[ci].range_m <= fixRange()) sg.gated_range_m = cands[ci].range_m;
     t.sightings.push_back(sg);
   }
   return a;

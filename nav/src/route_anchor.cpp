@@ -86,6 +86,7 @@ RouteAnchor::Correction RouteAnchor::correct(SectionTracker& tracker,
   fx.ranges_used = lf.ranges_used;
   fx.height_ranges = lf.height_ranges;
   fx.height_sigma_m = lf.height_sigma_m;
+  fx.gated_ranges = lf.gated_ranges;
   fx.ranges_dropped = lf.ranges_dropped;
   for (const auto& q : sightings)
     fx.sightings.push_back({q.origin.x(), q.origin.y(), q.direction, q.range_m});

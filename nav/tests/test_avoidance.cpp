@@ -359,8 +359,11 @@ TEST(Avoider, StepsOutOfTheLaneOfAWalkerTheTrackerSawComingFromTheSide) {
     const double axis = std::atan2(vel.y(), vel.x());
     EXPECT_GE(std::abs(std::sin(out.direction - axis)),
               std::sin(AvoidParams{}.lane_escape_deg * M_PI / 180) - 1e-9);
+    // The same lane test for behaviours that do not run the dodge (a recovery gives way).
+    EXPECT_TRUE(a.walkerLaneCovers({pose.x, pose.y}, at, vel));
   }
   for (const Eigen::Vector2d v : {Eigen::Vector2d(0.38, -0.12), Eigen::Vector2d(-0.1, -0.4)}) {
+    EXPECT_FALSE(ObstacleAvoider{}.walkerLaneCovers({pose.x, pose.y}, at, v)) << v.transpose();
     ObstacleAvoider a;
     a.setPose(pose);
     auto scan = test::scanAt(pose, {}, {{at.x(), at.y(), 0.25}}, 0.0);

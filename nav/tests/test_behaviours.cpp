@@ -257,6 +257,13 @@ TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
   ASSERT_TRUE(left.has_value());
   EXPECT_GT(*left, 0.0);
   EXPECT_LT(*left, M_PI - 0.1);
+  // The way back lies in the laser's blind sector (no range points there, which is not free
+  // floor: a person can stand at the robot's back): not taken without a scan that saw it free.
+  const auto seen_ahead = [](double a, double) { return std::abs(a) <= 2.1; };
+  EXPECT_FALSE(r.openDirection(dead_end, 0.3, 4.0, 0.0, seen_ahead).has_value());
+  const auto left_seen = r.openDirection(open_left, 0.3, 4.0, 0.0, seen_ahead);
+  ASSERT_TRUE(left_seen.has_value());
+  EXPECT_NEAR(*left_seen, *left, 1e-9);
   // Boxed in all round: nowhere.
   std::vector<std::pair<double, double>> box;
   for (int i = 0; i < 360; ++i) box.push_back({0.3 * std::cos(i * kDeg), 0.3 * std::sin(i * kDeg)});

@@ -184,6 +184,40 @@ TEST(LocateLandmark, LaserRangesThatAgreeWithTheHeightAreKept) {
   EXPECT_LT((f.position - lm).norm(), 0.1);
 }
 
+TEST(LocateLandmark, TakesBackLaserRangesTheSketchRefusedWhenTheHeightAgrees) {
+  // Straight at a poster on the wall ahead, from 4.2 to 3.4 m, its centre 0.9 m above the
+  // camera: the bearings never cross, the sketch put the poster 2 m nearer so its range gate
+  // refused every laser range (gated_range_m), and the height ranges alone are too loose
+  // (sigma ~0.35 m) to replace a laser range.
+  const Eigen::Vector2d lm(5.0, 0.1);
+  auto ss = approach(lm, 0.8, 1.6, 20, 0.1, 0.9, 0.0);
+  for (auto& s : ss) s.gated_range_m = s.range_m, s.range_m = 0;
+  EXPECT_TRUE(heightRanges(ss, LocateParams{}).range_m.empty());
+  const LandmarkFix f = locateLandmark(ss, LocateParams{});
+  ASSERT_TRUE(f.ok);
+  EXPECT_FALSE(f.bearing_only);
+  EXPECT_EQ(f.gated_ranges, 20);
+  EXPECT_EQ(f.ranges_used, 20);
+  EXPECT_LT((f.position - lm).norm(), 0.1) << f.position.transpose();
+
+  // Without taking them back the landmark is only somewhere along its rays.
+  LocateParams never;
+  never.gated_confirm_sigma_m = 0;
+  const LandmarkFix fb = locateLandmark(ss, never);
+  ASSERT_TRUE(fb.ok);
+  EXPECT_TRUE(fb.bearing_only);
+  EXPECT_EQ(fb.gated_ranges, 0);
+
+  // The laser hits a box 1.2 m in front of the poster: the height says the landmark is
+  // further, so those ranges stay refused.
+  auto boxed = ss;
+  for (auto& s : boxed) s.gated_range_m -= 1.2;
+  const LandmarkFix fx = locateLandmark(boxed, LocateParams{});
+  ASSERT_TRUE(fx.ok);
+  EXPECT_TRUE(fx.bearing_only);
+  EXPECT_EQ(fx.gated_ranges, 0);
+}
+
 TEST(LocateLandmark, NoHeightFromOneDistanceOrAtTheCameraHeight) {
   const Eigen::Vector2d lm(5.5, 0.4);
   // Standing still: every sighting from the same place, the height is not observable.

@@ -151,6 +151,31 @@ TEST(LandmarkTracker, AFarRangeIsKeptAsABearingOnlyWhenAsked) {
   }
 }
 
+TEST(LandmarkTracker, ARangeTheSketchRefusesIsKeptAsGatedForTheFix) {
+  // D (the only box) predicted 2 m ahead; the laser along its bearing reads 3.8 m, outside the
+  // range gate: taken by its bearing, the reading kept for locateLandmark to judge.
+  const auto route = fiveLandmarks();
+  SectionTracker sections(route);
+  RouteAnchor anchor;
+  anchor.start(sections);
+  const hw::Pose2D pose{0, 0, 0};
+  std::vector<AttendedLandmark> att = {{0, 3, {-0.12, 2.0}, true}};
+  std::vector<Detection> ds = {det("box", -0.12)};
+  std::vector<Candidate> all = {{&ds[0], 3.8}};
+  LandmarkTracker lt(route, {});
+  std::vector<bool> used(1, false);
+  const auto a =
+      lt.associate(att, 0, lt.expectations(att, pose), all, used, anchor, {}, pose, 1, 0, true);
+  ASSERT_TRUE(a.has_value());
+  ASSERT_TRUE(a->seen.has_value());
+  EXPECT_TRUE(a->seen->range_dropped);
+  EXPECT_EQ(a->range_m, 0.0);
+  const auto& ss = lt.track(0, 3).sightings;
+  ASSERT_EQ(ss.size(), 1u);
+  EXPECT_EQ(ss[0].range_m, 0.0);
+  EXPECT_EQ(ss[0].gated_range_m, 3.8);
+}
+
 TEST(LandmarkTracker, ADetectionWhereAnEarlierLandmarkOfItsClassWasFixedIsNotTheNextOne) {
   const auto route = fiveLandmarks();
   SectionTracker sections(route);

@@ -159,6 +159,17 @@ class ObstacleAvoider {
   /// walker coming at the robot from the side while it servoes on a landmark beside their
   /// lane). The avoider's own detection sees only what closes the corridor ahead.
   void offerWalker(const Eigen::Vector2d& position, const Eigen::Vector2d& velocity);
+  /// Whether a person at `position` walking at `velocity` (odometry frame) towards a robot at
+  /// `robot` has a lane (lane_horizon_s long, as wide as both bodies plus lane_margin_m) that
+  /// covers it: the test the dodge steps out of lanes by, for behaviours that do not run the
+  /// dodge (a recovery gives way to it).
+  bool walkerLaneCovers(const Eigen::Vector2d& robot, const Eigen::Vector2d& position,
+                        const Eigen::Vector2d& velocity) const;
+  /// Whether every part of the robot's disc swept `len` metres from its pose along `direction`
+  /// [rad, robot frame] lies on floor the newest remembered laser scan covering it saw free
+  /// (the current scan included; rear_memory_s). Unknown floor is not free. The pose and scans
+  /// are those of the last step().
+  bool sweptSeenFree(double direction, double len) const;
   /// Whether a point (odometry frame) lies where the floor was seen free a few seconds ago
   /// (the occupancy grid's memory, movers.h). Set, the point followed for the approach
   /// estimate counts as coming towards the robot only there: the nearest point of a wall or a
@@ -210,10 +221,6 @@ class ObstacleAvoider {
   /// Forward speed along the heading for direction `dir`: turn first beyond 1 rad, slow as the
   /// corridor ahead closes, none inside the minimum clearance (sets out.blocked).
   double forwardSpeed(double dir, double v, AvoidOutput& out) const;
-  /// Whether every part of the robot's disc swept `len` metres from its pose along `direction`
-  /// [rad, robot frame] lies on floor the newest remembered laser scan covering it saw free
-  /// (the current scan included; rear_memory_s). Unknown floor is not free.
-  bool sweptSeenFree(double direction, double len) const;
   void laneEscape(const std::vector<std::pair<double, double>>& pts, double target_bearing,
                   double heading, double v_nominal, const Eigen::Vector2d& lane_n, double lane_off,
                   AvoidOutput& out);

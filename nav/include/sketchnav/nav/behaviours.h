@@ -297,13 +297,20 @@ class Recovery {
   /// 36 directions, the one whose corridor of half-width `half_width_m` is free furthest (up to
   /// recover_m + 0.5, at least 0.5 m; `max_range_m`: the corridor test's reach), less 0.3 per
   /// rad away from `route_bearing`. None when no direction is free for 0.5 m.
-  std::optional<double> openDirection(const std::vector<std::pair<double, double>>& pts,
-                                      double half_width_m, double max_range_m,
-                                      double route_bearing) const;
+  /// `known_free` (when given): whether the robot's disc swept a length [m] along a
+  /// direction [rad, robot frame] lies on floor a laser scan saw free; directions where it does
+  /// not for 0.5 m are not taken. The laser does not see behind the robot, where a direction
+  /// without range points is not free, only unknown (a person waiting at the robot's back).
+  std::optional<double> openDirection(
+      const std::vector<std::pair<double, double>>& pts, double half_width_m, double max_range_m,
+      double route_bearing,
+      const std::function<bool(double direction, double len)>& known_free = {}) const;
   /// Starts driving towards robot-frame `direction` [rad] from `pose` at `now` [s].
   event::RecoverStart start(double direction, const hw::Pose2D& pose, double now);
   bool active() const { return active_; }
   int count() const { return count_; }
+  /// Ends the recovery under way (it gives way: a walker's lane covers the robot).
+  void stop() { active_ = false; }
 
   struct Step {
     Command command;

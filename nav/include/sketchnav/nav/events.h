@@ -103,6 +103,7 @@ struct PassedFix {
   std::string method;  // "ranges", "bearings", "bearing only"
   int rays = 0, ranges_used = 0, height_ranges = 0, ranges_dropped = 0;
   double height_sigma_m = 0;  // written only when height_ranges > 0
+  int gated_ranges = 0;       // laser ranges the sketch's gate refused, taken back
   // Sightings (origin x, y [m], direction [rad], range [m]), odometry frame, unrounded.
   std::vector<std::array<double, 4>> sightings;
   std::optional<PassedRefit> fit;  // one of fit / realign

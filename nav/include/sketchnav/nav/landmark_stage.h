@@ -111,6 +111,12 @@ struct LocateParams {
   double height_max_sigma_m = 0.15;         // [m] range error (from the fit) above this: not used
   double height_min_sigma_m = 0.08;         // [m] floor of a height range's error (shared by all)
   double height_agree_m = 0.15;             // [m] laser ranges within this (median) are kept
+  // A laser range the sketch's range gate refused (Sighting::gated_range_m: the landmark
+  // stands metres from where the drawing says) is taken back when height ranges with an error
+  // up to this [m] agree with it: median difference within max(height_agree_m, twice their
+  // error). Such height ranges are too loose to replace a laser range, not to tell the
+  // landmark's wall from an obstacle a metre or more in front of it. 0 = never taken back.
+  double gated_confirm_sigma_m = 0.5;
   template <class B>
   void bind(B& b) {
     b("bearing_sigma_deg", bearing_sigma_deg);
@@ -125,6 +131,7 @@ struct LocateParams {
     b("height_max_sigma_m", height_max_sigma_m);
     b("height_min_sigma_m", height_min_sigma_m);
     b("height_agree_m", height_agree_m);
+    b("gated_confirm_sigma_m", gated_confirm_sigma_m);
   }
   void validate() const;  // InputError "nav.locate.<field> = ...: ..."
 };
@@ -143,6 +150,8 @@ struct LandmarkFix {
   int ranges_used = 0, ranges_dropped = 0;
   int height_ranges = 0;      // sightings ranged by height (replacing the laser's or none)
   double height_sigma_m = 0;  // their range error (from the fit)
+  int gated_ranges = 0;       // laser ranges the sketch's gate refused, taken back (height
+                              // ranges agree with them; LocateParams::gated_confirm_sigma_m)
 };
 
 /// Height ranging alone (see LocateParams): per sighting the range it gives (0: none) and

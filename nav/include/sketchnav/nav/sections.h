@@ -59,6 +59,10 @@ struct Sighting {
   double elevation = NAN;
   double camera_along_m = 0;
   int photo = -1;
+  // A laser range along the bearing that the sketch's range gate refused (rangeAgrees()): the
+  // sketch's distances can be metres off, so locateLandmark() takes it back when the camera's
+  // own ranges (height ranging) agree with it. 0: none.
+  double gated_range_m = 0;
 };
 
 /// One fix for SectionTracker::fitSimilarityWeighted(): where the sketch puts a point (route
@@ -72,9 +76,9 @@ struct WeightedFix {
 };
 
 struct WeightedFitParams {
-  double sketch_sigma_m = 0.3;     // [m] how far off the user draws a landmark (per axis)
-  double outlier_m = 0.6;          // [m] a fix further than this off the fit (Mahalanobis
-                                   // distance x sketch_sigma_m) is left out
+  double sketch_sigma_m = 0.3;    // [m] how far off the user draws a landmark (per axis)
+  double outlier_m = 0.6;         // [m] a fix further than this off the fit (Mahalanobis
+                                  // distance x sketch_sigma_m) is left out
   double max_scale_change = 0.5;  // relative to the drawing's own scale (route metres)
 };
 
@@ -124,9 +128,9 @@ class SectionTracker {
   /// from the user's distance guesses (10-25 % off each); several fixes a few metres apart pin
   /// scale and heading down far better, and the error of each sketched position averages out
   /// instead of being copied by a shift. The scale stays within `max_scale_change` (relative)
-  /// of the drawing's own. Needs two or more fixes. With `outlier_m` > 0, the fix furthest off the fit is
-  /// left out and the rest refitted while it is more than `outlier_m` off and more than three
-  /// fixes remain.
+  /// of the drawing's own. Needs two or more fixes. With `outlier_m` > 0, the fix furthest off the
+  /// fit is left out and the rest refitted while it is more than `outlier_m` off and more than
+  /// three fixes remain.
   struct Fit {
     bool ok = false;
     double rotation = 0;     // [rad] change
