@@ -91,17 +91,11 @@ const char* toString(Split s) {
 
 namespace {
 
-bool isImage(const fs::path& p) {
-  std::string e = p.extension().string();
-  std::transform(e.begin(), e.end(), e.begin(), ::tolower);
-  return e == ".jpg" || e == ".jpeg" || e == ".png";
-}
-
 std::vector<std::string> imagesIn(const fs::path& dir) {
   std::vector<std::string> v;
   if (fs::is_directory(dir))
     for (const auto& e : fs::directory_iterator(dir))
-      if (e.is_regular_file() && isImage(e.path())) v.push_back(e.path().string());
+      if (e.is_regular_file() && isImageFileName(e.path().string())) v.push_back(e.path().string());
   std::sort(v.begin(), v.end());
   return v;
 }
@@ -111,7 +105,7 @@ std::map<std::string, std::vector<std::string>> classPhotos(const fs::path& root
   std::map<std::string, std::vector<std::string>> m;
   if (!fs::is_directory(root)) return m;
   for (const auto& e : fs::recursive_directory_iterator(root))
-    if (e.is_regular_file() && isImage(e.path()))
+    if (e.is_regular_file() && isImageFileName(e.path().string()))
       m[e.path().parent_path().filename().string()].push_back(e.path().string());
   for (auto& [c, v] : m) std::sort(v.begin(), v.end());
   return m;
