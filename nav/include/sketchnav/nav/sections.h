@@ -4,9 +4,11 @@
 //
 // Alignment: the odometry frame is the robot's start frame. At start the robot is assumed to
 // stand at the route's start facing `start_heading_rad`, so oMr (route -> odometry) is the
-// rotation by -start_heading about the start point. When a landmark is recognised at a place
-// that disagrees with the sketch, reanchor() shifts oMr (never rotates it: one bearing does
-// not fix a heading), so the rest of the route is followed relative to that landmark.
+// rotation by -start_heading about the start point. Landmarks located where the sketch does
+// not put them correct it (RouteAnchor decides which, route_anchor.h): reanchor() shifts oMr
+// only; realign() rotates it about an earlier fix (two fixes a baseline apart fix a heading,
+// one does not); fitSimilarityWeighted() refits rotation, scale and translation to all the
+// fixes at once. The rest of the route is then followed relative to the landmarks seen.
 #include <Eigen/Core>
 
 #include <cmath>
