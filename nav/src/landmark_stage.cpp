@@ -198,6 +198,18 @@ HeightRanges heightRanges(const std::vector<Sighting>& ss, const LocateParams& p
 }
 
 namespace {
+// Whether laser readings (per sighting, <= 0: none) agree with height ranges: the median of
+// their differences, over the sightings that have both, within `tolerance_m`. False when no
+// sighting has both.
+bool laserAgrees(const std::vector<double>& laser_m, const HeightRanges& hr, double tolerance_m) {
+  std::vector<double> diff;
+  for (size_t i = 0; i < laser_m.size(); ++i)
+    if (hr.range_m[i] > 0 && laser_m[i] > 0) diff.push_back(laser_m[i] - hr.range_m[i]);
+  if (diff.empty()) return false;
+  std::nth_element(diff.begin(), diff.begin() + diff.size() / 2, diff.end());
+  return std::abs(diff[diff.size() / 2]) <= tolerance_m;
+}
+
 // The sightings with the laser ranges the sketch's gate refused taken back when height
 // ranges confirm them (LocateParams::gated_confirm_sigma_m); counted in f.gated_ranges.
 std::vector<Sighting> withConfirmedRanges(std::vector<Sighting> ss, const LocateParams& p,
@@ -208,12 +220,10 @@ std::vector<Sighting> withConfirmedRanges(std::vector<Sighting> ss, const Locate
   loose.height_max_sigma_m = std::max(p.height_max_sigma_m, p.gated_confirm_sigma_m);
   const HeightRanges hc = heightRanges(ss, loose);
   if (hc.range_m.empty()) return ss;
-  std::vector<double> diff;
+  std::vector<double> refused(ss.size(), 0.0);
   for (size_t i = 0; i < ss.size(); ++i)
-    if (gated(ss[i]) && hc.range_m[i] > 0) diff.push_back(ss[i].gated_range_m - hc.range_m[i]);
-  if (diff.empty()) return ss;
-  std::nth_element(diff.begin(), diff.begin() + diff.size() / 2, diff.end());
-  if (std::abs(diff[diff.size() / 2]) > std::max(p.height_agree_m, 2 * hc.sigma_m)) return ss;
+    if (gated(ss[i])) refused[i] = ss[i].gated_range_m;
+  if (!laserAgrees(refused, hc, std::max(p.height_agree_m, 2 * hc.sigma_m))) return ss;
   for (auto& s : ss)
     if (gated(s)) s.range_m = s.gated_range_m, ++f.gated_ranges;
   return ss;
@@ -230,15 +240,9 @@ LandmarkFix locateLandmark(const std::vector<Sighting>& given, const LocateParam
   std::vector<Sighting> hs;
   const HeightRanges hr = heightRanges(sightings, p);
   if (!hr.range_m.empty()) {
-    std::vector<double> diff;
-    for (size_t i = 0; i < sightings.size(); ++i)
-      if (hr.range_m[i] > 0 && sightings[i].range_m > 0)
-        diff.push_back(sightings[i].range_m - hr.range_m[i]);
-    bool laser_agrees = false;
-    if (!diff.empty()) {
-      std::nth_element(diff.begin(), diff.begin() + diff.size() / 2, diff.end());
-      laser_agrees = std::abs(diff[diff.size() / 2]) <= p.height_agree_m;
-    }
+    std::vector<double> laser(sightings.size());
+    for (size_t i = 0; i < sightings.size(); ++i) laser[i] = sightings[i].range_m;
+    const bool laser_agrees = laserAgrees(laser, hr, p.height_agree_m);
     hs = sightings;
     for (size_t i = 0; i < hs.size(); ++i) {
       if (laser_agrees && hs[i].range_m > 0) continue;
