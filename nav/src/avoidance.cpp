@@ -14,6 +14,14 @@
 
 namespace sketchnav::nav {
 
+namespace {
+// [s] How far back the followed walker's trail reaches, and how long it has to be before it
+// can bear out (or refute) the walker's velocity: a standing person's few-centimetre jumps
+// average out over a second, while a walker at 0.2 m/s covers 6 cm in the shorter span.
+constexpr double kTrailS = 1.0;
+constexpr double kMinTrailS = 0.3;
+}  // namespace
+
 const char* toString(DodgeSide s) {
   switch (s) {
     case DodgeSide::Left:
@@ -154,6 +162,8 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
       walker_.vel = vel;
       walker_.pos = m;
       walker_.t = stamp;
+      walker_.trail.emplace_back(stamp, m);
+      while (stamp - walker_.trail.front().first > kTrailS) walker_.trail.pop_front();
     } else if (stamp - walker_.t > 0.6) {
       walker_.valid = false;
     }
@@ -164,10 +174,7 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
     // At rest until its own motion is measured: the approach estimate also fires on static
     // things (noise, a surface sliding into view), and seeded with it such a thing had a lane
     // for half a second (in 2 of 4 exp2-redrawn-c trials, at the start in room A).
-    walker_.valid = true;
-    walker_.pos = m;
-    walker_.vel.setZero();
-    walker_.t = stamp;
+    walker_ = {true, m, {0, 0}, stamp, false, {{stamp, m}}};
   }
 }
 
@@ -177,10 +184,36 @@ void ObstacleAvoider::offerWalker(const Eigen::Vector2d& position,
   const Eigen::Vector2d d = Eigen::Vector2d(pose_.x, pose_.y) - position;
   if (velocity.dot(d) <= 0) return;  // walking away
   const Walker keep = walker_;
-  walker_ = {true, position, velocity, prev_stamp_};
+  walker_ = {true, position, velocity, prev_stamp_, true, {{prev_stamp_, position}}};
   Eigen::Vector2d n;
   double off;
   if (!inLane(n, off)) walker_ = keep;
+}
+
+void ObstacleAvoider::observe(const std::vector<hw::RangeScan>& scans, const hw::Pose2D& pose) {
+  setPose(pose);
+  rememberScans(scans);
+}
+
+void ObstacleAvoider::rememberScans(const std::vector<hw::RangeScan>& scans) {
+  const auto& P = params_;
+  if (!have_pose_ || P.rear_memory_s <= 0 || P.lane_reverse_speed <= 0) return;
+  double stamp = -1;
+  for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
+  if (stamp <= seen_stamp_ + 1e-9) return;  // nothing new since the last
+  seen_stamp_ = stamp;
+  auto& seen = impl_->seen;
+  for (const auto& sc : scans)
+    if (sc.kind == hw::RangeScan::Kind::Laser)
+      // The sensor's pose once per scan, not per sample looked up in it.
+      seen.push_back(
+          {pose_.x + std::cos(pose_.theta) * sc.mount.x - std::sin(pose_.theta) * sc.mount.y,
+           pose_.y + std::sin(pose_.theta) * sc.mount.x + std::cos(pose_.theta) * sc.mount.y,
+           pose_.theta + sc.mount.theta, sc});
+  // A few metres of driving, or a while of turning on the spot; bounded in size whatever
+  // the laser's rate.
+  while (!seen.empty() && (seen.front().scan.stamp < stamp - P.rear_memory_s || seen.size() > 200))
+    seen.pop_front();
 }
 
 bool ObstacleAvoider::sweptSeenFree(double direction, double len) const {
@@ -247,8 +280,26 @@ bool laneCovers(const AvoidParams& P, const Eigen::Vector2d& robot, const Eigen:
 }
 }  // namespace
 
+bool ObstacleAvoider::walkerWalks() const {
+  // The follower's velocity is a filter over scan-to-scan steps of the visible side's centre.
+  // A person standing still jumps a few centimetres between scans while the robot turns
+  // (another side of them in view, the odometry's heading error), which the filter takes for
+  // 0.1-0.3 m/s in a direction that flips from one jump to the next; a lane from that sent the
+  // dodge left and right on the spot beside a person waiting in a corridor. A walker covers
+  // the ground their speed says: over the trail (up to kTrailS), at least half of it, along it.
+  const auto& tr = walker_.trail;
+  const double span = tr.empty() ? 0.0 : tr.back().first - tr.front().first;
+  // Handed over by the mover tracker: its velocity is a line fit over a second of steady
+  // motion already, trusted until the follower's own trail can check it.
+  if (span < kMinTrailS) return walker_.handed_over;
+  const double speed = walker_.vel.norm();
+  if (speed < 1e-9) return false;
+  const double moved = (tr.back().second - tr.front().second).dot(walker_.vel / speed);
+  return moved >= 0.5 * speed * span;
+}
+
 bool ObstacleAvoider::inLane(Eigen::Vector2d& normal, double& offset) const {
-  if (!walker_.valid || !have_pose_) return false;
+  if (!walker_.valid || !have_pose_ || !walkerWalks()) return false;
   return laneCovers(params_, {pose_.x, pose_.y}, walker_.pos, walker_.vel, normal, offset);
 }
 
@@ -489,21 +540,7 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
   const bool fresh = stamp > prev_stamp_ + 1e-9;
   const bool straight = std::abs(wrapAngle(heading - prev_heading_)) < 0.05;
-  if (fresh && have_pose_ && P.rear_memory_s > 0 && P.lane_reverse_speed > 0) {
-    auto& seen = impl_->seen;
-    for (const auto& sc : scans)
-      if (sc.kind == hw::RangeScan::Kind::Laser)
-        // The sensor's pose once per scan, not per sample looked up in it.
-        seen.push_back(
-            {pose_.x + std::cos(pose_.theta) * sc.mount.x - std::sin(pose_.theta) * sc.mount.y,
-             pose_.y + std::sin(pose_.theta) * sc.mount.x + std::cos(pose_.theta) * sc.mount.y,
-             pose_.theta + sc.mount.theta, sc});
-    // A few metres of driving, or a while of turning on the spot; bounded in size whatever
-    // the laser's rate.
-    while (!seen.empty() &&
-           (seen.front().scan.stamp < stamp - P.rear_memory_s || seen.size() > 200))
-      seen.pop_front();
-  }
+  rememberScans(scans);
   if (fresh && have_pose_) {
     // With the robot's pose: follow the nearest obstacle point in front (odometry frame) from
     // scan to scan. A point on something static only slides along its surface (across the

@@ -200,9 +200,19 @@ std::optional<double> Recovery::openDirection(
     const std::vector<std::pair<double, double>>& pts, double half_width_m, double max_range_m,
     double route_bearing, const std::function<bool(double, double)>& known_free) const {
   double best = -1e9, best_a = 0;
+  std::vector<std::pair<double, double>> ahead;
+  ahead.reserve(pts.size());
   for (int i = 0; i < 36; ++i) {
     const double a = wrapAngle(i * M_PI / 18);
-    const double free = corridorFree(pts, a, half_width_m, max_range_m);
+    // Only what lies ahead of the robot's centre along `a` is in the way: driving off, the
+    // robot only gets further from the rest. (corridorFree also counts a point within the
+    // corridor's half-width behind the centre, which freezes every direction once someone
+    // stands within the margin: a person who walked up to a robot's side boxed it in.)
+    ahead.clear();
+    const double c = std::cos(a), sn = std::sin(a);
+    for (const auto& p : pts)
+      if (c * p.first + sn * p.second > 0) ahead.push_back(p);
+    const double free = corridorFree(ahead, a, half_width_m, max_range_m);
     const double score =
         std::min(free, p_.recover_m + 0.5) - 0.3 * std::abs(wrapAngle(a - route_bearing));
     if (free >= 0.5 && score > best && (!known_free || known_free(a, 0.5)))
@@ -212,22 +222,25 @@ std::optional<double> Recovery::openDirection(
   return std::nullopt;
 }
 
-event::RecoverStart Recovery::start(double direction, const hw::Pose2D& pose, double now) {
+event::RecoverStart Recovery::start(double direction, const hw::Pose2D& pose, double now,
+                                    bool look) {
   active_ = true;
+  look_ = look;
   ++count_;
   dir_ = wrapAngle(pose.theta + direction);
   t0_ = now;
   from_ = pose;
-  return event::RecoverStart{direction * 180 / M_PI};
+  return event::RecoverStart{direction * 180 / M_PI, look};
 }
 
 Recovery::Step Recovery::step(const hw::Pose2D& pose, double now, double v_capped) {
   Step out;
   const double a = wrapAngle(dir_ - pose.theta);
   const double w = std::clamp(k_heading_ * a, -max_w_, max_w_);
-  const double v = std::abs(a) > 0.35 ? 0.0 : v_capped;
+  const double v = std::abs(a) > 0.35 || look_ ? 0.0 : v_capped;
   out.command = {v, w, turnOf(w)};
-  const bool blocked = std::abs(a) <= 0.35 && v <= 0;
+  // Looking: over once the direction is ahead, where the laser sees its floor.
+  const bool blocked = std::abs(a) <= 0.35 && (v <= 0 || look_);
   if (std::hypot(pose.x - from_.x, pose.y - from_.y) >= p_.recover_m || now - t0_ > p_.recover_s ||
       blocked) {
     active_ = false;

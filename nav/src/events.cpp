@@ -183,6 +183,7 @@ struct Writer {
   }
   const char* operator()(const event::RecoverStart& e) {
     j["direction_deg"] = e.direction_deg;
+    j["look"] = e.look;
     return "recover_start";
   }
   const char* operator()(const event::RecoverEnd&) { return "recover_end"; }

@@ -185,6 +185,7 @@ struct Executive::Impl {
   // Stuck recovery: where the robot was stuck_s ago, and an escape under way.
   ProgressChecker progress_checker;
   Recovery recovery;
+  bool looked = false;  // the last stuck test started a recovery that only turns to look
   Docking docker;
   Detour detour;         // a planned way round (or docking's path)
   bool in_lane = false;  // a walker's lane covered the robot at the last step
@@ -650,15 +651,27 @@ struct Executive::Impl {
       const bool stuck = progress_checker.stuck(pose, now);
       if (stuck) {
         const double hwid = s.avoid.robot_radius_m + s.avoid.corridor_margin_m;
-        const auto dir = recovery.openDirection(
-            scanPoints(scans), hwid, s.avoid.max_range_m, target_bearing,
+        const auto pts = scanPoints(scans);
+        auto dir = recovery.openDirection(
+            pts, hwid, s.avoid.max_range_m, target_bearing,
             [&](double a, double len) { return avoider.sweptSeenFree(a, len); });
+        // Nothing known free, but a way out the laser has not seen (behind the robot): turn
+        // to see it, then choose again. Once: what is still unseen after a look waits for the
+        // next stuck window, so a robot boxed in does not turn round and round.
+        bool look = false;
+        if (!dir && !looked) {
+          dir = recovery.openDirection(pts, hwid, s.avoid.max_range_m, target_bearing);
+          look = dir.has_value();
+        }
+        looked = look;
         if (dir) {
-          const auto started = recovery.start(*dir, pose, now);
+          const auto started = recovery.start(*dir, pose, now, look);
           if (avoider.active()) avoider.reset();
           event(started);
-          log::warn("nav", "stuck: driving clear before resuming",
-                    {{"direction_deg", std::to_string(static_cast<int>(*dir * 180 / M_PI))}});
+          log::warn(
+              "nav",
+              look ? "stuck: turning to see a way out" : "stuck: driving clear before resuming",
+              {{"direction_deg", std::to_string(static_cast<int>(*dir * 180 / M_PI))}});
         }
       }
     }
@@ -666,13 +679,18 @@ struct Executive::Impl {
       const auto r = recovery.step(pose, now, avoider.capSpeed(scans, 0.7 * s.exec.v_cruise));
       arb.propose(Behaviour::Recover, r.command);
       if (r.ended) {
-        progress_checker.reset(pose, now);
+        // After a look the way out is chosen at once, with the laser's view of it.
+        if (recovery.looking())
+          progress_checker.expire(pose, now);
+        else
+          progress_checker.reset(pose, now);
         event(event::RecoverEnd{});
       }
     }
     double front = 0;
     bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
     if (docking || recovery.active()) {
+      if (!dev.ranges.empty()) avoider.observe(scans, pose);
       endDetour(docking ? "docking" : "recovering");
       if (docking) arb.setWinnerSpeed(avoider.capSpeed(scans, arb.winner().v));
     } else if (!dev.ranges.empty()) {

@@ -493,6 +493,59 @@ TEST(Avoider, DoesNotBackOntoFloorNoScanHasSeen) {
   EXPECT_GE(m.min_v, 0.0);
 }
 
+TEST(Avoider, APersonStandingStillHasNoLaneHoweverTheirCentreJumps) {
+  // Generated corridor-1: a person waiting 1.2 m in front of a robot turning on the spot. The
+  // centre of their visible side jumped ~7 cm between scans (another side in view, the
+  // odometry's heading error), which the follower's filter read as 0.2 m/s in a direction
+  // that flipped from jump to jump, and the dodge turned left and right on the spot for 10 s
+  // after the flipping lane. A lane needs the walk its speed claims.
+  ObstacleAvoider a;
+  const hw::Pose2D pose{0, 0, 0};
+  auto stepAt = [&](double x, double y, double t) {
+    a.setPose(pose);
+    return a.step({test::scanAt(pose, {}, {{x, y, 0.25}}, t)}, 0.0, DodgeSide::Left, 0.0, 0.3, t);
+  };
+  // Handed over by the mover tracker walking at the robot; then standing still.
+  stepAt(1.2, 0.0, 0.0);
+  a.offerWalker({1.2, 0.0}, {-0.3, 0.0});
+  double t = 0.1;
+  for (; t < 1.55; t += 0.1) stepAt(1.2, 0.0, t);
+  // 7 cm towards the robot and back, to the side and back, a jump every 0.3 s, for 6 s.
+  const double jumps[4][2] = {{-0.07, 0.0}, {0.0, 0.0}, {0.0, 0.07}, {0.0, 0.0}};
+  int lanes = 0;
+  for (int k = 0; t < 7.55; t += 0.1, ++k) {
+    const auto& j = jumps[(k / 3) % 4];
+    lanes += stepAt(1.2 + j[0], j[1], t).in_lane ? 1 : 0;
+  }
+  EXPECT_EQ(lanes, 0) << "scans with a lane while the person stood still";
+  // Then they walk at the robot, 0.4 m/s: a lane within half a second (16 cm).
+  double lane_after = -1, x = 1.2;
+  for (const double t0 = t; t < t0 + 1.45; t += 0.1) {
+    x -= 0.04;
+    if (stepAt(x, 0.0, t).in_lane && lane_after < 0) lane_after = t - t0;
+  }
+  EXPECT_GE(lane_after, 0.0) << "no lane for a walker coming at the robot";
+  EXPECT_LE(lane_after, 0.5);
+}
+
+TEST(Avoider, JudgesTheFloorFromWhereTheRobotIsAfterAnotherBehaviourDrove) {
+  // step() at heading 0: a wall 0.45 m ahead, the back outside the laser's view. Then a
+  // recovery turns the robot round (observe() on its ticks, step() not called): what is now
+  // ahead was seen free, and the wall is behind.
+  AvoidParams p;
+  ObstacleAvoider a(p);
+  const std::vector<test::Box> wall{{0.5, 0.0, 0.05, 2.0}};  // inner face at x = 0.45
+  hw::Pose2D pose{0, 0, 0};
+  a.setPose(pose);
+  a.step({test::scanAt(pose, wall, {}, 0.0)}, 0.0, DodgeSide::Left, 0.0, 0.3, 0.0);
+  EXPECT_FALSE(a.sweptSeenFree(0.0, 0.5)) << "the wall";
+  EXPECT_FALSE(a.sweptSeenFree(M_PI, 0.5)) << "never seen";
+  pose.theta = M_PI;
+  a.observe({test::scanAt(pose, wall, {}, 0.5)}, pose);
+  EXPECT_TRUE(a.sweptSeenFree(0.0, 0.5)) << "seen free now that it faces it";
+  EXPECT_FALSE(a.sweptSeenFree(M_PI, 0.5)) << "the wall, now behind";
+}
+
 TEST(Avoider, NearTheAxisTakesTheSideItCanReachBeforeTheWalker) {
   // The robot stands 0.05 m south of a walker's axis facing north, a wall 1.0 m north of it
   // (0.68 m of room for its centre), open floor behind it to the south. The walker comes west

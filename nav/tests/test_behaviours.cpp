@@ -264,6 +264,15 @@ TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
   const auto left_seen = r.openDirection(open_left, 0.3, 4.0, 0.0, seen_ahead);
   ASSERT_TRUE(left_seen.has_value());
   EXPECT_NEAR(*left_seen, *left, 1e-9);
+  // A person who walked up to the robot's side (within the corridors' half-width of its
+  // centre, their body 0.03 m from its own) is in the way of the directions towards them
+  // only: driving off, the robot gets further from them.
+  std::vector<std::pair<double, double>> beside;
+  for (double a = -0.6; a <= 0.6; a += 0.1)  // the near side of a 0.2 m body centred 0.43 m right
+    beside.push_back({0.2 * std::sin(a), -0.43 + 0.2 * std::cos(a)});
+  const auto away = r.openDirection(beside, 0.32, 4.0, -M_PI / 2);
+  ASSERT_TRUE(away.has_value());
+  EXPECT_GT(*away, 0.0) << "away from the person on the right";
   // Boxed in all round: nowhere.
   std::vector<std::pair<double, double>> box;
   for (int i = 0; i < 360; ++i) box.push_back({0.3 * std::cos(i * kDeg), 0.3 * std::sin(i * kDeg)});
@@ -292,6 +301,19 @@ TEST(Recovery, DrivesClearTowardsTheMostOpenDirectionThenEnds) {
   r.start(0.0, from, 300.0);
   EXPECT_TRUE(r.step(from, 300.1, 0.0).ended);
   EXPECT_EQ(r.count(), 3);
+  // A look (the way out unseen): turn to face it, never drive, over once it is ahead.
+  const auto look = r.start(M_PI, from, 400.0, true);
+  EXPECT_TRUE(look.look);
+  EXPECT_TRUE(r.looking());
+  s = r.step(from, 400.1, 0.2);
+  EXPECT_DOUBLE_EQ(s.command.v, 0.0);
+  EXPECT_DOUBLE_EQ(std::abs(s.command.w), 0.8);
+  EXPECT_FALSE(s.ended);
+  s = r.step({1, 1, 2.9}, 402.0, 0.2);
+  EXPECT_DOUBLE_EQ(s.command.v, 0.0);
+  EXPECT_TRUE(s.ended);
+  EXPECT_FALSE(r.start(0.0, from, 500.0).look);
+  EXPECT_FALSE(r.looking());
 }
 
 // Docking: a free line to the goal is driven straight, slowing in the last 0.6 m; a blocked

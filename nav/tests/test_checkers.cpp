@@ -26,6 +26,12 @@ TEST(ProgressChecker, StuckWhenAWindowEndsWithoutMovingFarEnough) {
   pc.reset({5, 5, 0}, 31.0);
   EXPECT_FALSE(pc.due(40.0));
   EXPECT_FALSE(pc.stuck({5.5, 5, 0}, 41.0));
+  // expire() makes a window that is over at once, started where the robot is (after a
+  // recovery that only turned to look): due now, and stuck unless it moves.
+  pc.expire({6, 5, 0}, 50.0);
+  ASSERT_TRUE(pc.due(50.0));
+  EXPECT_TRUE(pc.stuck({6, 5, 2.0}, 50.0));
+  EXPECT_FALSE(pc.due(59.0));
 }
 
 TEST(SettleChecker, SettlesWhenNoLongerGettingCloserNearTheGoal) {

@@ -11,6 +11,7 @@
 // closer than `min_clearance_m` in the direction of motion the forward speed is zero.
 #include <Eigen/Core>
 
+#include <deque>
 #include <functional>
 #include <memory>
 #include <string>
@@ -165,6 +166,10 @@ class ObstacleAvoider {
   /// dodge (a recovery gives way to it).
   bool walkerLaneCovers(const Eigen::Vector2d& robot, const Eigen::Vector2d& position,
                         const Eigen::Vector2d& velocity) const;
+  /// For the ticks another behaviour drives (a recovery, docking) and step() is not called:
+  /// the pose and the laser scans, so that sweptSeenFree() judges from where the robot is
+  /// and with what it saw meanwhile (a recovery that turned to look at its back).
+  void observe(const std::vector<hw::RangeScan>& scans, const hw::Pose2D& pose);
   /// Whether every part of the robot's disc swept `len` metres from its pose along `direction`
   /// [rad, robot frame] lies on floor the newest remembered laser scan covering it saw free
   /// (the current scan included; rear_memory_s). Unknown floor is not free. The pose and scans
@@ -200,6 +205,7 @@ class ObstacleAvoider {
   double last_end_t_ = -1e300;
   hw::Pose2D pose_;
   bool have_pose_ = false;
+  double seen_stamp_ = -1e300;     // newest scan stamp in the memory sweptSeenFree() reads
   Eigen::Vector2d prev_pt_{0, 0};  // nearest obstacle point ahead at the last scan (odometry)
   double prev_pt_t_ = 0;
   bool have_prev_pt_ = false;
@@ -209,15 +215,21 @@ class ObstacleAvoider {
     bool valid = false;
     Eigen::Vector2d pos{0, 0}, vel{0, 0};
     double t = 0;
+    bool handed_over = false;  // offered by the mover tracker, its velocity a line fit
+    // Where the follower measured it over the last second (stamp, odometry frame).
+    std::deque<std::pair<double, Eigen::Vector2d>> trail;
   } walker_;
   // The side of the walker's axis the robot steps out to, a unit direction in the odometry
   // frame (zero: none chosen).
   Eigen::Vector2d lane_side_{0, 0};
   double lane_t_ = -1e300;  // when a lane last covered the robot
+  void rememberScans(const std::vector<hw::RangeScan>& scans);
   void followWalker(const std::vector<hw::RangeScan>& scans, double stamp, bool acquire);
   /// The unit normal from the walker's lane axis towards the robot, and the robot's offset
   /// from the axis [m], when the lane covers the robot; false otherwise.
   bool inLane(Eigen::Vector2d& normal, double& offset) const;
+  /// Whether the followed walker's trail bears out its velocity (see avoidance.cpp).
+  bool walkerWalks() const;
   /// Forward speed along the heading for direction `dir`: turn first beyond 1 rad, slow as the
   /// corridor ahead closes, none inside the minimum clearance (sets out.blocked).
   double forwardSpeed(double dir, double v, AvoidOutput& out) const;

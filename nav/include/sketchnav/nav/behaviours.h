@@ -305,8 +305,14 @@ class Recovery {
       const std::vector<std::pair<double, double>>& pts, double half_width_m, double max_range_m,
       double route_bearing,
       const std::function<bool(double direction, double len)>& known_free = {}) const;
-  /// Starts driving towards robot-frame `direction` [rad] from `pose` at `now` [s].
-  event::RecoverStart start(double direction, const hw::Pose2D& pose, double now);
+  /// Starts driving towards robot-frame `direction` [rad] from `pose` at `now` [s]; with
+  /// `look`, only turns to face it (the direction's floor unseen: openDirection found none
+  /// known free, but one that is only unknown), and ends facing it, for the next stuck test to
+  /// choose again with the laser's view of it.
+  event::RecoverStart start(double direction, const hw::Pose2D& pose, double now,
+                            bool look = false);
+  /// Whether the recovery under way (or the last one) only turns to look.
+  bool looking() const { return look_; }
   bool active() const { return active_; }
   int count() const { return count_; }
   /// Ends the recovery under way (it gives way: a walker's lane covers the robot).
@@ -324,6 +330,7 @@ class Recovery {
   RecoverParams p_;
   double k_heading_, max_w_;
   bool active_ = false;
+  bool look_ = false;
   int count_ = 0;
   double dir_ = 0, t0_ = 0;  // escape heading (odometry frame), start time
   hw::Pose2D from_;

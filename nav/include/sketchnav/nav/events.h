@@ -153,6 +153,9 @@ struct DetourEnd {
 };
 struct RecoverStart {
   double direction_deg = 0;  // robot frame
+  // Only turning to face the direction: its floor is out of the laser's view (the blind back
+  // sector), to be seen before it is driven over.
+  bool look = false;
 };
 struct RecoverEnd {};
 struct GoalSettled {

@@ -18,6 +18,12 @@ class ProgressChecker {
     from_ = pose;
     t_ = now;
   }
+  /// Makes the current window over at `now`, started at `pose`: the next stuck test is due at
+  /// once (after a recovery that only turned to look, the way out is chosen right away).
+  void expire(const hw::Pose2D& pose, double now) {
+    from_ = pose;
+    t_ = now - window_s_;
+  }
   /// Whether the current window is over at `now`.
   bool due(double now) const { return now - t_ >= window_s_; }
   /// Ends the current window at `pose`, `now` (call when due()): whether the robot moved less
