@@ -656,10 +656,10 @@ struct Executive::Impl {
             pts, hwid, s.avoid.max_range_m, target_bearing,
             [&](double a, double len) { return avoider.sweptSeenFree(a, len); });
         // Nothing known free, but a way out the laser has not seen (behind the robot): turn
-        // to see it, then choose again. Once: what is still unseen after a look waits for the
-        // next stuck window, so a robot boxed in does not turn round and round.
+        // to see it, then choose again (recover_look). Once: what is still unseen after a look
+        // waits for the next stuck window, so a robot boxed in does not turn round and round.
         bool look = false;
-        if (!dir && !looked) {
+        if (!dir && !looked && s.exec.recover_look) {
           dir = recovery.openDirection(pts, hwid, s.avoid.max_range_m, target_bearing);
           look = dir.has_value();
         }

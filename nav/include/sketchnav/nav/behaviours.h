@@ -237,12 +237,18 @@ struct RecoverParams {
   double stuck_m = 0.3;    // [m]
   double recover_m = 1.0;  // [m] then drive this far towards the most open direction
   double recover_s = 8;    // [s] (at most this long) and resume
+  // With no direction known free but one only unseen (the laser's blind back sector), turn on
+  // the spot to face it first, then choose again. Off by default: turning round towards a
+  // person waiting at the robot's back is what makes them walk on into it (doc/navigation.md
+  // "Evidence for the defaults").
+  bool recover_look = false;
   template <class B>
   void bind(B& b) {
     b("stuck_s", stuck_s);
     b("stuck_m", stuck_m);
     b("recover_m", recover_m);
     b("recover_s", recover_s);
+    b("recover_look", recover_look);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };
