@@ -15,10 +15,8 @@
 namespace sketchnav::nav {
 
 namespace {
-// [s] How far back the followed walker's trail reaches, and how long it has to be before it
-// can bear out (or refute) the walker's velocity: a standing person's few-centimetre jumps
-// average out over a second, while a walker at 0.2 m/s covers 6 cm in the shorter span.
-constexpr double kTrailS = 1.0;
+// [s] How long the followed walker's trail has to be before it can bear out (or refute) the
+// walker's velocity (AvoidParams::lane_trail_s): a walker at 0.2 m/s covers 6 cm in it.
 constexpr double kMinTrailS = 0.3;
 }  // namespace
 
@@ -63,6 +61,8 @@ void AvoidParams::validate() const {
   require(max_turn_rate > 0, "nav.avoid.max_turn_rate", "must be > 0 rad/s");
   require(lane_reverse_speed >= 0 && lane_reverse_speed <= 1.0, "nav.avoid.lane_reverse_speed",
           "must be in [0, 1] m/s (0 = no backing out of a lane)");
+  require(lane_trail_s == 0 || (lane_trail_s >= 0.5 && lane_trail_s <= 5), "nav.avoid.lane_trail_s",
+          "must be 0 (off) or in [0.5, 5] s");
   require(rear_memory_s >= 0 && rear_memory_s <= 30, "nav.avoid.rear_memory_s",
           "must be in [0, 30] s");
 }
@@ -163,7 +163,7 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
       walker_.pos = m;
       walker_.t = stamp;
       walker_.trail.emplace_back(stamp, m);
-      while (stamp - walker_.trail.front().first > kTrailS) walker_.trail.pop_front();
+      while (stamp - walker_.trail.front().first > params_.lane_trail_s) walker_.trail.pop_front();
     } else if (stamp - walker_.t > 0.6) {
       walker_.valid = false;
     }
@@ -286,7 +286,8 @@ bool ObstacleAvoider::walkerWalks() const {
   // (another side of them in view, the odometry's heading error), which the filter takes for
   // 0.1-0.3 m/s in a direction that flips from one jump to the next; a lane from that sent the
   // dodge left and right on the spot beside a person waiting in a corridor. A walker covers
-  // the ground their speed says: over the trail (up to kTrailS), at least half of it, along it.
+  // the ground their speed says: over the trail (lane_trail_s), at least half of it, along it.
+  if (params_.lane_trail_s <= 0) return true;
   const auto& tr = walker_.trail;
   const double span = tr.empty() ? 0.0 : tr.back().first - tr.front().first;
   // Handed over by the mover tracker: its velocity is a line fit over a second of steady

@@ -64,6 +64,13 @@ struct AvoidParams {
   double lane_escape_deg = 60;   // [deg] from the lane's axis (90 = straight out sideways)
   double max_turn_rate = 0.8;    // [rad/s] how fast the base turns (nav.max_w), to choose the
                                  // side out of a lane
+  // [s] > 0: a walker the dodge follows itself has a lane only while its trail over this long
+  // bears its filtered speed out (at least half the distance, along it, once the trail spans
+  // 0.3 s): a person standing still, whose laser centre jumps a few centimetres while the robot
+  // turns, has none. 0 = off: the filtered speed alone (0.2 m/s) makes a lane, a few tenths of
+  // a second sooner for someone who starts walking. Off by default: doc/navigation.md
+  // "Evidence for the defaults".
+  double lane_trail_s = 0.0;
   // Backing out of a walker's lane: where the way out lies behind the robot, reversing along
   // it (at lane_reverse_speed) is also a way out, taken when it gets out sooner than turning
   // round to drive forwards. The laser does not see behind the robot, so a way back is taken
@@ -97,6 +104,7 @@ struct AvoidParams {
     b("lane_margin_m", lane_margin_m);
     b("lane_escape_deg", lane_escape_deg);
     b("max_turn_rate", max_turn_rate);
+    b("lane_trail_s", lane_trail_s);
     b("lane_reverse_speed", lane_reverse_speed);
     b("rear_memory_s", rear_memory_s);
     b("sectors", sectors);
