@@ -224,7 +224,7 @@ class ObstacleAvoider {
     Eigen::Vector2d pos{0, 0}, vel{0, 0};
     double t = 0;
     bool handed_over = false;  // offered by the mover tracker, its velocity a line fit
-    // Where the follower measured it over the last second (stamp, odometry frame).
+    // Where the follower measured it over the last lane_trail_s (stamp, odometry frame).
     std::deque<std::pair<double, Eigen::Vector2d>> trail;
   } walker_;
   // The side of the walker's axis the robot steps out to, a unit direction in the odometry
