@@ -162,8 +162,11 @@ void ObstacleAvoider::followWalker(const std::vector<hw::RangeScan>& scans, doub
       walker_.vel = vel;
       walker_.pos = m;
       walker_.t = stamp;
-      walker_.trail.emplace_back(stamp, m);
-      while (stamp - walker_.trail.front().first > params_.lane_trail_s) walker_.trail.pop_front();
+      if (params_.lane_trail_s > 0) {  // kept only for walkerWalks(), which needs it on
+        walker_.trail.emplace_back(stamp, m);
+        while (stamp - walker_.trail.front().first > params_.lane_trail_s)
+          walker_.trail.pop_front();
+      }
     } else if (stamp - walker_.t > 0.6) {
       walker_.valid = false;
     }

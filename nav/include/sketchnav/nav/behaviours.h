@@ -301,8 +301,9 @@ class Recovery {
 
   /// The most open direction [rad, robot frame] from the range points `pts` (robot frame): of
   /// 36 directions, the one whose corridor of half-width `half_width_m` is free furthest (up to
-  /// recover_m + 0.5, at least 0.5 m; `max_range_m`: the corridor test's reach), less 0.3 per
-  /// rad away from `route_bearing`. None when no direction is free for 0.5 m.
+  /// recover_m + 0.5, at least 0.5 m; `max_range_m`: the corridor test's reach; only points
+  /// ahead of the robot's centre along it count), less 0.3 per rad away from `route_bearing`.
+  /// None when no direction is free for 0.5 m.
   /// `known_free` (when given): whether the robot's disc swept a length [m] along a
   /// direction [rad, robot frame] lies on floor a laser scan saw free; directions where it does
   /// not for 0.5 m are not taken. The laser does not see behind the robot, where a direction
