@@ -29,9 +29,10 @@ PACKAGES=(
   ros-actionlib-msgs
   # the action's Python messages (genpy) and the rospy + actionlib client ros/scripts/sketchnav_route.py
   python3-genpy python3-rospy python3-actionlib
-  # /diagnostics, the annotated image, rviz markers; roslaunch / rostopic for the tests
+  # /diagnostics, the annotated image, rviz markers; roslaunch / rostopic / rosbag record for
+  # the tests
   libdiagnostic-updater-dev libdiagnostic-msgs-dev libimage-transport-dev
-  libvisualization-msgs-dev libtf2-msgs-dev python3-roslaunch python3-rostopic
+  libvisualization-msgs-dev libtf2-msgs-dev python3-roslaunch python3-rostopic python3-rosbag
 )
 
 missing=()

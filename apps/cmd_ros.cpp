@@ -49,14 +49,18 @@ int runSim(const std::vector<std::string>& argv0, GlobalOptions& g) {
   Args args("ros sim",
             "the built-in simulator as a ROS robot: camera, odometry + tf, laser, sonar, "
             "ground truth and /clock; drives from cmd_vel",
-            "[--world NAME|FILE] [--seed N] [--rate R] [--max-time S] [--no-hold] [from:=to ...]");
+            "[--world NAME|FILE] [--seed N] [--rate R] [--max-time S] [--no-hold] [--lockstep] "
+            "[from:=to ...]");
   args.option("world", "a world name in share/worlds or a .world.json file", "lab")
       .option("seed", "simulator seed", "1")
       .option("rate", "simulated seconds per wall second (0 = as fast as possible)", "1")
       .option("step", "publishing step [s, simulated]: /clock, odom, tf", "0.02")
       .option("cmd-timeout", "a cmd_vel older than this [s, simulated] is replaced by zero", "0.5")
       .option("max-time", "end after this many simulated seconds (default: run until stopped)")
-      .flag("no-hold", "start simulated time at once (default: hold it at 0 until a cmd_vel)");
+      .flag("no-hold", "start simulated time at once (default: hold it at 0 until a cmd_vel)")
+      .flag("lockstep",
+            "step only when the navigation (ros nav with ros.lockstep=true) has answered: "
+            "time stands while it perceives, as in sketchnav run");
   if (!args.parse(argv)) return 0;
   ros::SimBridgeOptions o;
   o.world = args.get("world");
@@ -68,6 +72,7 @@ int runSim(const std::vector<std::string>& argv0, GlobalOptions& g) {
   if (!(o.cmd_timeout_s > 0)) throw InputError("sketchnav ros sim: --cmd-timeout must be > 0");
   if (!args.get("max-time").empty()) o.max_time_s = args.getDouble("max-time");
   o.hold_until_cmd = !args.flagSet("no-hold");
+  o.lockstep = args.flagSet("lockstep");
   ros::init("sketchnav_sim", ros_args, 10.0);
   o.config = mergedSettings(g);
   Json s;
@@ -215,8 +220,9 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     ros::startWatchdog(rp);
     // The executive grabs a frame once nav.camera_period_s - tick_s / 2 has passed since the
     // last: such a frame wakes the control loop instead of waiting for its next tick.
-    ros::wakeOnFrames(rp.wake_on_frame ? rs.nav.exec.camera_period_s - 0.5 * rs.nav.exec.tick_s
-                                       : -1.0);
+    ros::wakeOnFrames(rp.wake_on_frame && !rp.lockstep
+                          ? rs.nav.exec.camera_period_s - 0.5 * rs.nav.exec.tick_s
+                          : -1.0);
     ros::registerDrivers();
     // The executive's own staleness limits on ROS time: ros.stale_timeout_s unless set.
     for (const char* k :

@@ -142,6 +142,10 @@ class BagCamera final : public hw::Camera {
         log::warn("bag", "frame skipped: " + st_.last_error, {{"uri", uri_}});
         continue;
       }
+      // A frame stamped like the one before is that frame sent again (a simulator holding its
+      // time while a node starts, recorded by rosbag record): replayed once, as it was seen.
+      if (have_t0_ && !stamp.isZero() && stamp == last_stamp_) continue;
+      last_stamp_ = stamp;
       if (!have_t0_) {
         t0_ = stamp.toSec();
         have_t0_ = true;
@@ -201,6 +205,7 @@ class BagCamera final : public hw::Camera {
   std::unique_ptr<rosbag::View> view_;
   rosbag::View::iterator it_;
   double hfov_ = 0, t0_ = 0;
+  ::ros::Time last_stamp_;
   bool have_t0_ = false, have_info_ = false, sized_ = false;
   std::uint64_t seq_ = 0, index_ = 0;
   hw::Intrinsics intr_;

@@ -26,6 +26,7 @@
 #include <set>
 
 #include "bag_internal.h"
+#include "internal.h"
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/json_io.h"
 #include "sketchnav/core/log.h"
@@ -274,25 +275,41 @@ std::string topicOf(rosbag::Bag& bag, const Uri& u, const std::string& type,
                         : "several " + type + " topics (" + list + "): choose one with ?topic="));
 }
 
+// Opens `path` for reading; InputError naming it when it is no bag.
+void openToRead(rosbag::Bag& bag, const std::string& path) {
+  try {
+    bag.open(path, rosbag::bagmode::Read);
+  } catch (const std::exception& e) {
+    throw InputError(path + ": cannot be read as a ROS bag (" + e.what() + ")");
+  }
+}
+
 // The transform base_link (or base_footprint) -> `frame` on the bag's tf_static / tf, one hop;
 // false when the bag has none.
-bool mountInBag(rosbag::Bag& bag, const std::string& frame, hw::Pose2D& out) {
+bool transformInBag(rosbag::Bag& bag, const std::string& frame, geometry_msgs::Transform& out) {
   rosbag::View v(bag, rosbag::TopicQuery(std::vector<std::string>{"/tf_static", "/tf"}));
   for (const auto& m : v) {
     const auto tf = m.instantiate<tf2_msgs::TFMessage>();
     if (!tf) continue;
-    for (const auto& t : tf->transforms) {
-      if (t.child_frame_id != frame ||
-          (t.header.frame_id != "base_link" && t.header.frame_id != "base_footprint"))
-        continue;
-      const auto& q = t.transform.rotation;
-      double r, p, yaw;
-      tf2::Matrix3x3(tf2::Quaternion(q.x, q.y, q.z, q.w)).getRPY(r, p, yaw);
-      out = {t.transform.translation.x, t.transform.translation.y, yaw};
-      return std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.theta);
-    }
+    for (const auto& t : tf->transforms)
+      if (t.child_frame_id == frame &&
+          (t.header.frame_id == "base_link" || t.header.frame_id == "base_footprint")) {
+        out = t.transform;
+        return true;
+      }
   }
   return false;
+}
+
+// A sensor's mount in the plane (x, y, yaw) from the bag's tf; false when the bag has none.
+bool mountInBag(rosbag::Bag& bag, const std::string& frame, hw::Pose2D& out) {
+  geometry_msgs::Transform t;
+  if (!transformInBag(bag, frame, t)) return false;
+  const auto& q = t.rotation;
+  double r, p, yaw;
+  tf2::Matrix3x3(tf2::Quaternion(q.x, q.y, q.z, q.w)).getRPY(r, p, yaw);
+  out = {t.translation.x, t.translation.y, yaw};
+  return std::isfinite(out.x) && std::isfinite(out.y) && std::isfinite(out.theta);
 }
 
 // Messages of one topic in bag order, delivered on the run's clock: a message stamped s is due
@@ -605,11 +622,7 @@ void registerBagDevices() {
       ".bag", [](const std::string& path) { return std::make_shared<BagRecorder>(path); });
   drivers::registerRunInfoReader(".bag", [](const std::string& path) -> Json {
     rosbag::Bag bag;
-    try {
-      bag.open(path, rosbag::bagmode::Read);
-    } catch (const std::exception& e) {
-      throw InputError(path + ": cannot be read as a ROS bag (" + e.what() + ")");
-    }
+    openToRead(bag, path);
     rosbag::View v(bag, rosbag::TopicQuery(kRunInfoTopic));
     for (const auto& m : v)
       if (auto s = m.instantiate<std_msgs::String>()) {
@@ -618,6 +631,29 @@ void registerBagDevices() {
         return j;
       }
     return Json::object();
+  });
+  drivers::registerRecordedRobotReader(".bag", [](const std::string& path) -> Json {
+    rosbag::Bag bag;
+    openToRead(bag, path);
+    // The optical frame of the bag's first image, raw or compressed.
+    std::string frame;
+    for (const auto& m : rosbag::View(bag)) {
+      if (auto im = m.instantiate<sensor_msgs::Image>())
+        frame = im->header.frame_id;
+      else if (auto ci = m.instantiate<sensor_msgs::CompressedImage>())
+        frame = ci->header.frame_id;
+      if (!frame.empty()) break;
+    }
+    geometry_msgs::Transform t;
+    if (frame.empty() || !transformInBag(bag, frame, t)) return Json::object();
+    const CameraMount c = detail::opticalMount(t);
+    if (!std::isfinite(c.x_m) || !std::isfinite(c.z_m) || !std::isfinite(c.yaw) ||
+        !std::isfinite(c.pitch))
+      return Json::object();
+    return Json{{"robot.camera.x_m", c.x_m},
+                {"robot.camera.z_m", c.z_m},
+                {"robot.camera.yaw", c.yaw},
+                {"robot.camera.pitch", c.pitch}};
   });
 }
 

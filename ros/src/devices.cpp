@@ -232,10 +232,14 @@ class RosCamera final : public hw::Camera {
     bool due = false;
     {
       std::lock_guard<std::mutex> l(m_);
+      // A frame stamped like the one before is that frame sent again (a simulator holding its
+      // time while a node starts), not a new one: grab() must not hand it out twice.
+      if (seq_ > 0 && !stamp.isZero() && stampOf(stamp) == stamp_) return;
       latest_ = img;
       stamp_ = stampOf(stamp);
       ++seq_;
       ++st_.received;
+      in_->stamp_last = stamp_;
       due = stamp_ >= delivered_stamp_ + state().wake_gap_s;
       std::lock_guard<std::mutex> ll(state().latency_mutex);
       auto& fr = state().latency.frames;
@@ -343,6 +347,8 @@ class RosBase final : public hw::Base {
     t.linear.x = v;
     t.angular.z = w;
     pub_.publish(t);
+    state().last_v = v;
+    state().last_w = w;
     closeLatency();
     std::lock_guard<std::mutex> l(m_);
     ++st_.received;
@@ -352,6 +358,8 @@ class RosBase final : public hw::Base {
       pub_.publish(geometry_msgs::Twist());
     } catch (...) {
     }
+    state().last_v = 0.0;
+    state().last_w = 0.0;
   }
   bool odometry(hw::Odometry& out) override {
     std::lock_guard<std::mutex> l(m_);
@@ -407,6 +415,7 @@ class RosBase final : public hw::Base {
     odom_.w = m->twist.twist.angular.z;
     odom_.stamp = stampOf(m->header.stamp);
     have_ = true;
+    in_->stamp_last = odom_.stamp;
   }
 
   static std::string strip(const std::string& f) {
@@ -468,6 +477,7 @@ class RosBase final : public hw::Base {
     }
     odom_.pose = {p.x, p.y, yaw};
     odom_.stamp = stamp;
+    in_->stamp_last = stamp;
     have_ = true;
     ++st_.received;
   }
@@ -599,6 +609,7 @@ class RosLaser final : public hw::RangeSensor {
                                        : r;
     }
     std::lock_guard<std::mutex> l(m_);
+    in_->stamp_last = s.stamp;
     scan_ = std::move(s);
     have_ = true;
     ++st_.received;
@@ -702,6 +713,10 @@ class RosSonar final : public hw::RangeSensor {
     std::lock_guard<std::mutex> l(m_);
     beams_[m->header.frame_id] = b;
     ++st_.received;
+    // The ring is as new as its oldest transducer (one message each, possibly in flight).
+    double oldest = 1e300;
+    for (const auto& [frame, beam] : beams_) oldest = std::min(oldest, beam.stamp);
+    in_->stamp_last = oldest;
   }
 
   mutable std::mutex m_;

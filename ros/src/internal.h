@@ -14,6 +14,9 @@
 #include <thread>
 #include <vector>
 
+#include <geometry_msgs/Transform.h>
+
+#include "sketchnav/core/camera_mount.h"
 #include "sketchnav/ros/node.h"
 
 namespace sketchnav::ros::detail {
@@ -24,7 +27,10 @@ struct Input {
   std::string topic;                    // resolved name
   std::atomic<double> wall_last{-1.0};  // [s] wallNow() of the last message, -1 before the first
   std::atomic<bool> had_publisher{false};
-  std::atomic<bool> active{true};             // false once its device is closing
+  std::atomic<bool> active{true};  // false once its device is closing
+  // [s, ROS time] header stamp of the last message delivered to its device (lock-step: the
+  // node's time moves to a step once every input has what the simulator sent up to it)
+  std::atomic<double> stamp_last{-1e300};
   std::function<std::uint32_t()> publishers;  // number of connected publishers
 };
 
@@ -65,6 +71,17 @@ struct State {
   std::condition_variable wake_cv;
   std::uint64_t frames_due = 0;               // guarded by wake_m
   std::atomic<std::uint64_t> frame_wakes{0};  // sleeps a frame ended early (this camera's)
+  // Lock-step with `ros sim --lockstep` (RosParams::lockstep, doc/ros.md "Lock-step").
+  std::atomic<bool> lockstep{false};
+  ::ros::Subscriber lockstep_step;
+  ::ros::Publisher lockstep_ack;
+  std::vector<double> step;  // the simulator's last step: t and the stamps it had sent (wake_m)
+  double lockstep_now = -1;  // [s, ROS time] the node's time: the last step all inputs reached
+                             // (wake_m); < 0 before the first
+  // [s, wall] when the control loop began waiting for the simulator; < 0 while it works (the
+  // simulator waits for it then, so its inputs are not stale)
+  std::atomic<double> lockstep_wait_since{-1.0};
+  std::atomic<double> last_v{0.0}, last_w{0.0};  // the last command the base published
 };
 
 State& state();
@@ -77,5 +94,8 @@ void addInput(const std::shared_ptr<Input>& in);
 void removeInput(const std::shared_ptr<Input>& in);
 /// Throws RuntimeError when init() has not run.
 ::ros::NodeHandle& nodeHandle();
+/// The camera mount of an image's optical frame (REP 103: z forward, x right, y down) given
+/// the transform base frame -> that frame: position, and the optical axis's yaw and pitch.
+CameraMount opticalMount(const geometry_msgs::Transform& t);
 
 }  // namespace sketchnav::ros::detail

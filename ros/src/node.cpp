@@ -2,6 +2,7 @@
 #include <ros/ros.h>
 #include <sensor_msgs/CompressedImage.h>
 #include <sensor_msgs/Image.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_msgs/String.h>
 #include <tf2/LinearMath/Matrix3x3.h>
 #include <tf2/LinearMath/Quaternion.h>
@@ -31,6 +32,19 @@ State& state() {
   return s;
 }
 
+CameraMount opticalMount(const geometry_msgs::Transform& t) {
+  const auto& q = t.rotation;
+  const tf2::Matrix3x3 R(tf2::Quaternion(q.x, q.y, q.z, q.w));
+  // The optical axis (z of an optical frame, REP 103) in the base frame.
+  const tf2::Vector3 d = R * tf2::Vector3(0, 0, 1);
+  CameraMount m;
+  m.x_m = t.translation.x;
+  m.z_m = t.translation.z;
+  m.yaw = std::atan2(d.y(), d.x());
+  m.pitch = std::atan2(d.z(), std::hypot(d.x(), d.y()));
+  return m;
+}
+
 double wallNow() {
   using C = std::chrono::steady_clock;
   static const C::time_point t0 = C::now();
@@ -42,6 +56,8 @@ void publishZero() noexcept {
     State& s = state();
     if (!s.have_cmd_vel) return;
     s.cmd_vel.publish(geometry_msgs::Twist());
+    s.last_v = 0.0;
+    s.last_w = 0.0;
   } catch (...) {
   }
 }
@@ -128,14 +144,19 @@ void watchdogLoop() {
       p = s.params;
       inputs = s.inputs;
     }
+    // Lock-step: the simulator sends nothing while this node works on a step (it waits for
+    // it), so an input is judged only while the control loop waits, from when it began to.
+    const double lockstep_since = s.lockstep ? s.lockstep_wait_since.load() : 0.0;
     for (const auto& in : inputs) {
-      const double last = in->wall_last;
+      double last = in->wall_last;
       if (last < 0) continue;  // not judged before its first message (the device waits for it)
       if (!in->active) continue;
       const std::uint32_t n = in->publishers ? in->publishers() : 1;
       if (n > 0) in->had_publisher = true;
+      const bool judged = !s.lockstep || lockstep_since >= 0;
+      if (s.lockstep) last = std::max(last, lockstep_since);
       char b[256];
-      if (now - last > p.stale_timeout_s) {
+      if (judged && now - last > p.stale_timeout_s) {
         std::snprintf(b, sizeof b,
                       "%s on %s: no usable message for %.2f s (limit ros.stale_timeout_s = %.2f s)",
                       in->what.c_str(), in->topic.c_str(), now - last, p.stale_timeout_s);
@@ -247,15 +268,55 @@ void livenessLoop() {
   }
 }
 
+// Lock-step (RosParams::lockstep): which entry of the simulator's step message holds the
+// stamp an input must have reached; -1 for inputs the step does not describe.
+int stepIndex(const std::string& what) {
+  if (what == "camera") return 4;
+  if (what.rfind("odometry", 0) == 0) return 1;
+  if (what == "laser scan") return 2;
+  if (what == "sonar") return 3;
+  return -1;
+}
+
+// The node's time in lock-step: the simulator's latest step once every input has received
+// what the simulator had sent up to it (topics travel on separate connections, so /clock or
+// the step message may arrive before the data); before the first step, ROS time.
+double lockstepNow() {
+  State& s = state();
+  std::vector<std::shared_ptr<detail::Input>> inputs;
+  {
+    std::lock_guard<std::mutex> l(s.mutex);
+    inputs = s.inputs;
+  }
+  std::lock_guard<std::mutex> l(s.wake_m);
+  if (s.step.size() >= 5 && s.step[0] > s.lockstep_now) {
+    bool ready = true;
+    for (const auto& in : inputs) {
+      const int k = stepIndex(in->what);
+      if (k < 0 || !in->active || s.step[k] < 0) continue;
+      // Stamps travel as ROS times (nanoseconds): equal within a microsecond.
+      if (in->stamp_last < s.step[k] - 1e-6) ready = false;
+    }
+    if (ready) s.lockstep_now = s.step[0];
+  }
+  return s.lockstep_now >= 0 ? s.lockstep_now : ::ros::Time::now().toSec();
+}
+
 class RosClock final : public hw::Clock {
  public:
-  double now() const override { return ::ros::Time::now().toSec(); }
+  double now() const override {
+    return state().lockstep ? lockstepNow() : ::ros::Time::now().toSec();
+  }
   void sleepUntil(double t) override {
+    State& s = state();
+    if (s.lockstep) {
+      lockstepSleepUntil(t);
+      return;
+    }
     // Returns early on a fault: under simulated time a dead simulator freezes /clock, and the
     // executive must still reach its next tick to stop. Returns early, too, when a camera
     // frame the executive will grab arrives (wakeOnFrames()): the frame need not wait for the
     // next tick (up to a whole tick_s otherwise). Each such frame wakes it once.
-    State& s = state();
     std::unique_lock<std::mutex> l(s.wake_m);
     while (now() < t && !s.tripped && ::ros::ok()) {
       if (s.wake_gap_s >= 0 && s.frames_due > woken_) {
@@ -269,6 +330,27 @@ class RosClock final : public hw::Clock {
   }
 
  private:
+  // Tells the simulator that this node is done until t (with the command it sent last: one
+  // message, so the simulator cannot apply a step's command before it has it), then waits
+  // until the simulator has stepped to t and every input has what it sent up to then.
+  void lockstepSleepUntil(double t) {
+    State& s = state();
+    if (lockstepNow() >= t) return;
+    std_msgs::Float64MultiArray ack;
+    ack.data = {t, s.last_v.load(), s.last_w.load()};
+    s.lockstep_ack.publish(ack);
+    s.lockstep_wait_since = detail::wallNow();
+    while (!s.tripped && ::ros::ok()) {
+      // The simulator steps to t exactly; its time may come back a rounding error short.
+      if (lockstepNow() >= t - 1e-9) {
+        std::lock_guard<std::mutex> l(s.wake_m);
+        s.lockstep_now = std::max(s.lockstep_now, t);
+        break;
+      }
+      std::this_thread::sleep_for(std::chrono::microseconds(200));
+    }
+    s.lockstep_wait_since = -1.0;
+  }
   std::uint64_t woken_ = 0;  // frames_due when sleepUntil() last returned (guarded by wake_m)
 };
 
@@ -377,6 +459,24 @@ void startWatchdog(const RosParams& p) {
     std::lock_guard<std::mutex> l(s.mutex);
     s.params = p;
   }
+  if (p.lockstep && !s.lockstep) {
+    ::ros::NodeHandle& nh = detail::nodeHandle();
+    s.lockstep_ack = nh.advertise<std_msgs::Float64MultiArray>("lockstep/ack", 10);
+    boost::function<void(const std_msgs::Float64MultiArrayConstPtr&)> on_step =
+        [](const std_msgs::Float64MultiArrayConstPtr& m) {
+          for (double x : m->data)
+            if (!std::isfinite(x)) return detail::garbage("lockstep/step: a value is not finite");
+          if (m->data.size() < 5)
+            return detail::garbage("lockstep/step: " + std::to_string(m->data.size()) +
+                                   " values, expected 5 (t, odometry, scan, sonar, camera)");
+          std::lock_guard<std::mutex> l(state().wake_m);
+          state().step = m->data;
+        };
+    s.lockstep_step = nh.subscribe<std_msgs::Float64MultiArray>("lockstep/step", 10, on_step);
+    s.lockstep = true;
+    log::info("ros", "lock-step with the simulator: time moves when this node has answered",
+              {{"step", s.lockstep_step.getTopic()}, {"ack", s.lockstep_ack.getTopic()}});
+  }
   if (!s.watchdog.joinable()) {
     s.watchdog = std::thread(watchdogLoop);
     s.liveness = std::thread(livenessLoop);
@@ -446,14 +546,7 @@ bool lookupCameraMount(const std::string& base_frame, const std::string& camera_
       std::this_thread::sleep_for(std::chrono::milliseconds(20));
     }
   }
-  const auto& q = t.transform.rotation;
-  const tf2::Matrix3x3 R(tf2::Quaternion(q.x, q.y, q.z, q.w));
-  // The optical axis (z of an optical frame, REP 103) in the base frame.
-  const tf2::Vector3 d = R * tf2::Vector3(0, 0, 1);
-  out.x_m = t.transform.translation.x;
-  out.z_m = t.transform.translation.z;
-  out.yaw = std::atan2(d.y(), d.x());
-  out.pitch = std::atan2(d.z(), std::hypot(d.x(), d.y()));
+  out = detail::opticalMount(t.transform);
   return true;
 }
 

@@ -11,6 +11,7 @@
 #include <sensor_msgs/Image.h>
 #include <sensor_msgs/LaserScan.h>
 #include <sensor_msgs/Range.h>
+#include <std_msgs/Float64MultiArray.h>
 #include <std_msgs/String.h>
 #include <tf2/LinearMath/Quaternion.h>
 #include <tf2_ros/static_transform_broadcaster.h>
@@ -125,6 +126,29 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
         ++cmds;
       };
   auto sub_cmd = nh.subscribe<geometry_msgs::Twist>("cmd_vel", 10, on_cmd);
+  // Lock-step (SimBridgeOptions::lockstep): the node's answers, [until (ROS time), v, w].
+  double ack_until = -1e300, ack_v = 0, ack_w = 0;  // guarded by cmd_m
+  std::uint64_t acks = 0;
+  ::ros::Publisher pub_step;
+  ::ros::Subscriber sub_ack;
+  if (o.lockstep) {
+    // Latched: a node that subscribes late still learns the step it must reach.
+    pub_step = nh.advertise<std_msgs::Float64MultiArray>("lockstep/step", 10, true);
+    boost::function<void(const std_msgs::Float64MultiArrayConstPtr&)> on_ack =
+        [&](const std_msgs::Float64MultiArrayConstPtr& m) {
+          if (m->data.size() < 3 || !std::isfinite(m->data[0]) || !std::isfinite(m->data[1]) ||
+              !std::isfinite(m->data[2])) {
+            log::warn("ros-sim", "lockstep/ack: ignored (expected 3 finite values: until, v, w)");
+            return;
+          }
+          std::lock_guard<std::mutex> l(cmd_m);
+          ack_until = std::max(ack_until, m->data[0] - kRosEpoch);
+          ack_v = m->data[1];
+          ack_w = m->data[2];
+          ++acks;
+        };
+    sub_ack = nh.subscribe<std_msgs::Float64MultiArray>("lockstep/ack", 10, on_ack);
+  }
 
   // Static frames: the camera's optical frame, the laser, one frame per sonar transducer.
   const ::ros::Time t0 = rosTime(0.0);
@@ -184,6 +208,15 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   sensor_msgs::CameraInfo info_msg;
 
   bool collision_logged = false;
+  // [s, ROS time] stamps of the last odometry, scan, sonar ring and frame published (-1: none):
+  // what a lock-step node must have received before its time may move to a step.
+  double sent_odom = -1, sent_scan = -1, sent_sonar = -1, sent_frame = -1;
+  auto publishLockstep = [&](double t) {
+    if (!o.lockstep) return;
+    std_msgs::Float64MultiArray m;
+    m.data = {t + kRosEpoch, sent_odom, sent_scan, sent_sonar, sent_frame};
+    pub_step.publish(m);
+  };
   // Reads every device at the clock's time t and publishes what is new.
   auto publishStep = [&](double t) {
     const ::ros::Time rt = rosTime(t);
@@ -208,6 +241,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
       m.twist.twist.linear.x = od.v;
       m.twist.twist.angular.z = od.w;
       pub_odom.publish(m);
+      sent_odom = rt.toSec();
       tfb.sendTransform(
           transform("odom", "base_link", od.pose.x, od.pose.y, 0, yawQ(od.pose.theta), rt));
     }
@@ -242,6 +276,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
         m.ranges[i] =
             sc.ranges[i] >= sc.max_range ? std::numeric_limits<float>::infinity() : sc.ranges[i];
       pub_scan.publish(m);
+      sent_scan = m.header.stamp.toSec();
       ++scans;
     }
     if (w.sonar.enabled && simr->sonar().read(sc) && sc.stamp > last_sonar) {
@@ -262,6 +297,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
                                                : static_cast<float>(sc.ranges[i] - off);
         pub_sonar.publish(m);
         sonar_msgs.push_back(m);
+        sent_sonar = m.header.stamp.toSec();
       }
     }
     // Camera: a frame whenever a frame period has begun (grab() would otherwise wait for one,
@@ -295,6 +331,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
         ci.R = {1, 0, 0, 0, 1, 0, 0, 0, 1};
         ci.P = {K.fx, 0, K.cx, 0, 0, K.fy, K.cy, 0, 0, 0, 1, 0};
         pub_info.publish(ci);
+        sent_frame = h.stamp.toSec();
         ++frames;
       }
     }
@@ -302,14 +339,17 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
 
   log::info("ros-sim", "running", {{"world", w.name}, {"seed", std::to_string(o.seed)}});
   publishStep(clk->now());
-  if (o.hold_until_cmd) {
-    // Time held at 0 until the navigation's first command: it starts on the same simulated
-    // instant as an in-process `sketchnav run`, however long it took to load its model.
-    log::info("ros-sim", "simulated time held at 0 until the first cmd_vel");
+  publishLockstep(clk->now());
+  if (o.hold_until_cmd || o.lockstep) {
+    // Time held at 0 until the navigation's first command (lock-step: its first answer): it
+    // starts on the same simulated instant as an in-process `sketchnav run`, however long it
+    // took to load its model. The t = 0 data is sent again meanwhile, for a node that joins.
+    log::info("ros-sim", o.lockstep ? "lock-step: simulated time moves when the navigation answers"
+                                    : "simulated time held at 0 until the first cmd_vel");
     while (ok() && !(stop && stop())) {
       {
         std::lock_guard<std::mutex> l(cmd_m);
-        if (cmds > 0) break;
+        if (o.lockstep ? acks > 0 : cmds > 0) break;
       }
       clockAt(clk->now());
       pub_odom.publish(odom_msg);
@@ -346,22 +386,52 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   const double sim0 = clk->now();
   double next_state = 0;
   Json last;
+  std::uint64_t lockstep_waits = 0;
+  double lockstep_wait_s = 0;  // [s, wall] spent waiting for the navigation
   while (ok() && !(stop && stop())) {
     double t = clk->now();
     if (o.max_time_s > 0 && t >= o.max_time_s) break;
-    // The latest command holds until it is cmd_timeout_s old (a base's watchdog).
-    {
+    double next = t + o.step_s;
+    if (o.lockstep) {
+      // The node is done with time t once it waits for a later time: until then, no step.
+      const double w0 = detail::wallNow();
+      bool told = false;
+      for (;;) {
+        {
+          std::lock_guard<std::mutex> l(cmd_m);
+          if (ack_until > t + 1e-9) {
+            simr->base().command(ack_v, ack_w);
+            // Exactly to the node's wake-up time when it falls within the step, so it sees
+            // the data of that instant (as `sketchnav run` and a replay do).
+            next = std::min(next, ack_until);
+            break;
+          }
+        }
+        if (!ok() || (stop && stop())) break;
+        if (!told && detail::wallNow() - w0 > 5.0) {
+          told = true;
+          log::warn("ros-sim", "lock-step: no answer from the navigation for 5 s; still waiting",
+                    {{"t", std::to_string(t)}});
+        }
+        std::this_thread::sleep_for(std::chrono::microseconds(200));
+      }
+      if (!ok() || (stop && stop())) break;
+      ++lockstep_waits;
+      lockstep_wait_s += detail::wallNow() - w0;
+    } else {
+      // The latest command holds until it is cmd_timeout_s old (a base's watchdog).
       std::lock_guard<std::mutex> l(cmd_m);
       if (t - cmd_t > o.cmd_timeout_s)
         simr->base().command(0, 0);
       else
         simr->base().command(cmd_v, cmd_w);
     }
-    t += o.step_s;
+    t = next;
     clk->sleepUntil(t);
     simr->sync();
     ++steps;
     publishStep(t);
+    publishLockstep(t);
     if (t >= next_state) {
       last = publishState(t);
       next_state = t + 0.5;
@@ -380,6 +450,7 @@ Json runSimBridge(const SimBridgeOptions& o, const std::function<bool()>& stop) 
   last["wall_time_s"] = wall;
   last["real_time_factor"] = wall > 0 ? (clk->now() - sim0) / wall : 0.0;
   last["scans_published"] = scans;
+  if (o.lockstep) last["lockstep"] = {{"steps", lockstep_waits}, {"wait_wall_s", lockstep_wait_s}};
   last["world"] = w.name;
   last["seed"] = o.seed;
   return last;

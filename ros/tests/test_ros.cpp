@@ -380,6 +380,90 @@ TEST_F(RosTest, SimAndNavThroughAMasterDriveTheShortLabRoute) {
       r["time_s"].get<double>(), r["odom_path_m"].get<double>(), s["path_length_m"].get<double>());
 }
 
+// Lock-step (`ros sim --lockstep`, ros.lockstep): simulated time moves only when the node has
+// answered, so a run through ROS depends on nothing but its messages. `rosbag record` beside
+// the live run, then `run --replay` of that bag: every tick gives the live run's mode, turn,
+// landmark and command (the camera mount comes from the bag's tf, as the node took it live;
+// the frames are the compressed ones the node decoded).
+TEST_F(RosTest, ALockstepRunRecordedWithRosbagReplaysToItsCommands) {
+  if (std::system("command -v rosbag >/dev/null 2>&1") != 0)
+    GTEST_SKIP() << "rosbag (python3-rosbag) not installed";
+  const std::string sketch = shortLabSketch(dir_);
+  sim_ = std::make_unique<Process>(
+      cmd({"--json", "ros", "sim", "--world", "lab", "--seed", "1", "--rate", "0", "--lockstep"}),
+      (dir_ / "sim.out").string(), (dir_ / "sim.err").string());
+  ASSERT_TRUE(waitFor([] { return ros::param::has("/use_sim_time"); }, 20)) << logs();
+  const std::string bag = (dir_ / "run.bag").string();
+  Process record(
+      {"rosbag", "record", "-O", bag, "/odom", "/scan", "/sonar", "/image_raw/compressed",
+       "/camera_info", "/tf", "/tf_static", "/cmd_vel", "__name:=test_record"},
+      (dir_ / "record.out").string(), (dir_ / "record.err").string());
+  // Recording before the route starts (time stands at 0 until the node answers).
+  ASSERT_TRUE(waitFor(
+      [] {
+        XmlRpc::XmlRpcValue args, result, payload;
+        args[0] = ros::this_node::getName();
+        if (!ros::master::execute("getSystemState", args, result, payload, false)) return false;
+        for (int i = 0; i < payload[1].size(); ++i)
+          if (std::string(payload[1][i][0]) == "/image_raw/compressed")
+            for (int j = 0; j < payload[1][i][1].size(); ++j)
+              if (std::string(payload[1][i][1][j]) == "/test_record") return true;
+        return false;
+      },
+      30))
+      << "rosbag record did not subscribe: " << record.err();
+  const fs::path live = dir_ / "live", replay = dir_ / "replay";
+  startNav(sketch, {"--set", "ros.lockstep=true", "--set", "ros.image_transport=compressed",
+                    "--out", live.string(), "--max-time", "60"});
+  ASSERT_TRUE(nav_->wait(240)) << "ros nav did not end" << logs();
+  ASSERT_EQ(nav_->exitCode(), 0) << logs();
+  record.signal(SIGINT);
+  ASSERT_TRUE(record.wait(20)) << record.err();
+  ASSERT_TRUE(fs::exists(bag)) << record.err();
+  sim_->signal(SIGINT);
+  ASSERT_TRUE(sim_->wait(10));
+  const Json s = Json::parse(sim_->out());
+  EXPECT_GT(s["lockstep"]["steps"].get<int>(), 100) << s.dump(1);
+
+  Process rerun(cmd({"--json", "run", "--replay", bag, "--sketch", sketch, "--out", replay.string(),
+                     "--cache-dir", SKETCHNAV_MODEL_CACHE_DIR}),
+                (dir_ / "replay.out").string(), (dir_ / "replay.err").string());
+  ASSERT_TRUE(rerun.wait(240)) << "the replay did not end";
+  ASSERT_TRUE(rerun.exitedNormally()) << rerun.err();
+
+  // telemetry.csv: t, ..., v_cmd, w_cmd, servo_error, mode, turn, section, landmark, ...
+  const auto rows = [](const fs::path& f) {
+    std::ifstream in(f);
+    std::string line;
+    std::getline(in, line);
+    std::vector<std::vector<std::string>> out;
+    while (std::getline(in, line)) {
+      std::vector<std::string> cells;
+      std::stringstream ss(line);
+      for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+      out.push_back(cells);
+    }
+    return out;
+  };
+  const auto a = rows(live / "telemetry.csv"), b = rows(replay / "telemetry.csv");
+  ASSERT_GT(a.size(), 100u) << "the live run is too short to compare";
+  ASSERT_GE(b.size(), a.size()) << rerun.err();
+  int differ = 0;
+  for (size_t i = 0; i < a.size(); ++i) {
+    ASSERT_GE(a[i].size(), 14u);
+    ASSERT_GE(b[i].size(), 14u);
+    const bool same = std::abs(std::stod(a[i][0]) - std::stod(b[i][0])) < 1e-6 &&
+                      std::abs(std::stod(a[i][7]) - std::stod(b[i][7])) < 1e-5 &&
+                      std::abs(std::stod(a[i][8]) - std::stod(b[i][8])) < 1e-5 &&
+                      a[i][10] == b[i][10] && a[i][11] == b[i][11] && a[i][13] == b[i][13];
+    if (!same && differ++ < 3)
+      ADD_FAILURE() << "tick " << i << " (t = " << a[i][0] << " s) differs: live v " << a[i][7]
+                    << " w " << a[i][8] << " " << a[i][10] << ", replay t " << b[i][0] << " v "
+                    << b[i][7] << " w " << b[i][8] << " " << b[i][10];
+  }
+  EXPECT_EQ(differ, 0) << "of " << a.size() << " ticks";
+}
+
 TEST_F(RosTest, KillingTheSimulatorStopsTheRobotWithin200Ms) {
   startSim("1");
   if (HasFatalFailure()) return;

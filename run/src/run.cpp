@@ -506,15 +506,22 @@ Json runNavigation(const RunOptions& o) {
     // The robot's geometry the recorded run used (RunInfo), unless the user overrides it: a
     // replay with another camera mount would servo differently on the same frames.
     // Recordings made before the mount was one setting group name it the old way.
+    // A recording without run info (a bag recorded beside a ROS robot) may still show the
+    // camera's mount in its tf, as `ros nav` took it live (readRecordedRobot).
     const Json info = drivers::readRunInfo(o.replay);
+    const Json robot = drivers::readRecordedRobot(o.replay);
     const auto take = [&](const std::string& key, double& v) {
       std::string k = key;
       for (const auto& [old_key, new_key] : cameraMountRenames())
         if (new_key == key && !info.contains(key) && info.contains(old_key)) k = old_key;
-      if (o.config.has(key) || !info.contains(k)) return;
-      if (!info[k].is_number())
-        throw InputError("--replay " + o.replay + ": run info '" + k + "' is not a number");
-      v = info[k].get<double>();
+      if (o.config.has(key)) return;
+      const bool recorded = info.contains(k);
+      const Json& from = recorded ? info : robot;
+      if (!from.contains(k)) return;
+      if (!from[k].is_number())
+        throw InputError("--replay " + o.replay + ": " + (recorded ? "run info" : "recorded tf") +
+                         " '" + k + "' is not a number");
+      v = from[k].get<double>();
     };
     take("robot.camera.x_m", rs.camera.x_m);
     take("robot.camera.z_m", rs.camera.z_m);

@@ -40,6 +40,7 @@ struct Recorders {
   std::mutex m;
   std::map<std::string, RecorderFactory> by_extension;
   std::map<std::string, RunInfoReader> info_by_extension;
+  std::map<std::string, RunInfoReader> robot_by_extension;
 };
 Recorders& recorders() {
   static Recorders r;
@@ -154,6 +155,24 @@ void registerRunInfoReader(const std::string& extension, RunInfoReader reader) {
   auto& r = recorders();
   std::lock_guard<std::mutex> l(r.m);
   r.info_by_extension[extension] = std::move(reader);
+}
+
+void registerRecordedRobotReader(const std::string& extension, RunInfoReader reader) {
+  auto& r = recorders();
+  std::lock_guard<std::mutex> l(r.m);
+  r.robot_by_extension[extension] = std::move(reader);
+}
+
+Json readRecordedRobot(const std::string& path) {
+  RunInfoReader reader;
+  {
+    auto& r = recorders();
+    std::lock_guard<std::mutex> l(r.m);
+    const auto it = r.robot_by_extension.find(std::filesystem::path(path).extension().string());
+    if (it == r.robot_by_extension.end()) return Json::object();
+    reader = it->second;
+  }
+  return reader(path);
 }
 
 Json readRunInfo(const std::string& path) {

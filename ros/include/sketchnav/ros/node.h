@@ -56,6 +56,13 @@ struct RosParams {
   std::string odom_frame = "odom";    // the odometry frame (tf source; pose, route, markers)
   bool camera_mount_from_tf = true;   // robot.camera.* (the camera mount) from tf
                                       // base_frame -> the image's frame, unless set
+  // Lock-step with `ros sim --lockstep`: the node's time moves only to the simulator's steps
+  // whose data every input has received, and each time the control loop waits it tells the
+  // simulator until when (lockstep/ack, with its last command), so the simulator steps only
+  // when the node has answered. Simulated time stands while a frame is perceived, as in
+  // `sketchnav run`: the run is the same however loaded the machine is, and a bag recorded
+  // of it replays to its commands. Turns wake_on_frame off. Only with that simulator.
+  bool lockstep = false;
   template <class B>
   void bind(B& b) {
     b("stale_timeout_s", stale_timeout_s);
@@ -73,6 +80,7 @@ struct RosParams {
     b("odom_source", odom_source);
     b("odom_frame", odom_frame);
     b("camera_mount_from_tf", camera_mount_from_tf);
+    b("lockstep", lockstep);
   }
   void validate() const;  // InputError "ros.<field> = ...: ..."
 };

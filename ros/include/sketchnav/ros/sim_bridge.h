@@ -28,7 +28,14 @@ struct SimBridgeOptions {
   double cmd_timeout_s = 0.5;  // [s, simulated] base watchdog
   double max_time_s = 0;       // [s, simulated] > 0: end after this long
   bool hold_until_cmd = true;  // hold time at 0 (re-sending the t = 0 data) until a cmd_vel
-  Config config;               // sim.* settings
+  // Lock-step with a node whose ros.lockstep is on: after each step, the simulator publishes
+  // lockstep/step (latched Float64MultiArray: t and the ROS stamps of the last odometry, scan,
+  // sonar and frame sent, -1 for none) and steps again only once the node has answered on
+  // lockstep/ack ([until (ROS time), v, w]: it waits for a later time, with the command to
+  // apply), stepping exactly to `until` when it falls within a step. Time is held at 0 until
+  // the first answer. Commands come from the answers (cmd_vel is not needed); rate still paces.
+  bool lockstep = false;
+  Config config;  // sim.* settings
 };
 
 /// Runs until SIGINT / SIGTERM, ros::shutdown, `stop()` true or max_time_s. The ROS node must

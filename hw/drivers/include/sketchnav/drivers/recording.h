@@ -43,6 +43,15 @@ using RunInfoReader = std::function<Json(const std::string& path)>;
 /// `extension` with its dot, e.g. ".bag"; thread-safe.
 void registerRunInfoReader(const std::string& extension, RunInfoReader reader);
 
+/// What a recording made elsewhere shows of the robot without run info, as setting keys: a ROS
+/// bag's tf gives the camera mount (robot.camera.*, from base_link to its images' optical
+/// frame), as `ros nav` takes it from live tf. An empty object when it shows nothing (a
+/// rawlog; a bag without tf to its camera). A replay takes these for the keys neither the run
+/// info nor the user sets. Unlike run info, they do not change the replay's time origin.
+Json readRecordedRobot(const std::string& path);
+/// `extension` with its dot; thread-safe.
+void registerRecordedRobotReader(const std::string& extension, RunInfoReader reader);
+
 /// A RawlogRecorder as a Recorder (labels CAMERA, ODOMETRY, LASER / SONAR, CMD_VEL / CMD_STOP).
 std::shared_ptr<Recorder> rawlogRecorder(std::shared_ptr<RawlogRecorder> rawlog);
 
