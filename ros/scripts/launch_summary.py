@@ -8,7 +8,9 @@ import roslaunch.config
 
 
 def main():
-    cfg = roslaunch.config.load_config_default(sys.argv[1:], None, verbose=False)
+    # Launch arguments (name:=value) stay in sys.argv, where roslaunch's loader reads them.
+    files = [a for a in sys.argv[1:] if ":=" not in a]
+    cfg = roslaunch.config.load_config_default(files, None, verbose=False)
     out = {"nodes": [], "params": {}}
     for n in cfg.nodes:
         out["nodes"].append({"name": n.name, "namespace": n.namespace, "package": n.package,

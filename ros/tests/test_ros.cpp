@@ -1382,6 +1382,15 @@ TEST(RosLaunch, LaunchFilesParse) {
   // $(find sketchnav) resolved to this source tree's sketch.
   const std::string sk = nav_args.substr(17, nav_args.find(' ', 17) - 17);
   EXPECT_TRUE(fs::exists(sk)) << sk;
+  EXPECT_EQ(nodes["sketchnav_sim"]["args"].get<std::string>().find("--lockstep"),
+            std::string::npos);
+  EXPECT_EQ(sim["params"]["/sketchnav_nav/ros/lockstep"], false);
+  // lockstep:=true: both sides in lock-step.
+  const Json locked = load("sim_nav.launch lockstep:=true");
+  for (const auto& n : locked["nodes"])
+    if (n["name"] == "sketchnav_sim")
+      EXPECT_NE(n["args"].get<std::string>().find("--lockstep"), std::string::npos) << n.dump();
+  EXPECT_EQ(locked["params"]["/sketchnav_nav/ros/lockstep"], true);
   const Json robot = load("robot.launch");
   ASSERT_EQ(robot["nodes"].size(), 1u);
   const Json& remap = robot["nodes"][0]["remap"];
