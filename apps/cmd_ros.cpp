@@ -161,6 +161,8 @@ struct RouteView {
 // The frame perception examined with what it found (detection windows, class, inliers).
 cv::Mat annotate(const hw::Frame& f, const nav::Observation& obs) {
   cv::Mat img = f.image.clone();
+  // The windows examined, thin and grey beneath the detections: where perception looked.
+  for (const auto& w : obs.windows) cv::rectangle(img, w, cv::Scalar(160, 160, 160), 1);
   for (const auto& d : obs.detections) {
     const cv::Scalar c = d.tracked           ? cv::Scalar(255, 160, 0)
                          : d.recognised_only ? cv::Scalar(0, 200, 255)

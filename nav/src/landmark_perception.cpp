@@ -387,6 +387,7 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
 
   const auto windows = proposing.valid() ? proposing.get() : proposeWindows();
   ob.timing.windows = static_cast<int>(windows.size());
+  for (const auto& w : windows) ob.windows.push_back(w.box);
 
   t = clk::now();
   const landmarks::MatchParams mp = matchParams(P);

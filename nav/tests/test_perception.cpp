@@ -289,6 +289,7 @@ TEST_F(FoveaTest, TrackingServesTheFramesBetweenFullPasses) {
     EXPECT_NEAR(d.x_t, K.normalisedX(u), 0.25 * width / K.fx) << "frame " << i;
     EXPECT_EQ(ob.timing.full_pass, i % 3 == 0) << "frame " << i;
     EXPECT_EQ(d.tracked, !ob.timing.full_pass) << "frame " << i;
+    EXPECT_EQ(ob.windows.empty(), !ob.timing.full_pass) << "frame " << i;  // none examined
     EXPECT_EQ(ob.timing.tracked, d.tracked ? 1 : 0);
     EXPECT_EQ(ob.timing.track_steps, i == 0 ? 0 : 1) << "frame " << i;  // one track from frame 0
     ASSERT_TRUE(d.match);
@@ -456,6 +457,10 @@ TEST_F(RecognitionStage, TwoThreadsFindExactlyWhatOneFinds) {
       }
       EXPECT_EQ(one.timing.windows, two.timing.windows);
       EXPECT_EQ(one.timing.recognised, two.timing.recognised);
+      // The windows examined are reported, the same on either thread count.
+      EXPECT_EQ(static_cast<int>(one.windows.size()), one.timing.windows);
+      EXPECT_EQ(one.windows, two.windows);
+      EXPECT_GT(one.windows.size(), 0u);
       detections += static_cast<int>(one.detections.size());
     }
   }

@@ -74,6 +74,9 @@ struct LookFor {
 
 struct Observation {
   std::vector<Detection> detections;  // at most one per landmark-sized region, best first
+  // The objectness windows the full pass examined (frame pixels; what a view of perception
+  // draws besides the detections); empty when no full pass ran (a tracked frame).
+  std::vector<cv::Rect> windows;
   PerceptionTiming timing;
 };
 
