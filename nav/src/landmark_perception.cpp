@@ -163,10 +163,10 @@ bool toDetection(const landmarks::MatchResult& m, const std::string& cls, const 
   d.inliers = m.inliers;
   d.confidence = m.confidence;
   // Servo feature in normalised coordinates (doc/conventions.md). x_t: where the object
-  // is; x_d such that x_t - x_d is the chosen offset measure.
+  // is; x_d the desired position: the image centre, or with paper_offset such that x_t - x_d
+  // is the paper's median offset.
   d.x_t = K.normalisedX(off.object_u);
-  const double err_px = P.paper_offset ? off.paper_offset_px : off.offset_px;
-  d.x_d = d.x_t - err_px / K.fx;
+  d.x_d = P.paper_offset ? d.x_t - off.paper_offset_px / K.fx : 0.0;
   d.bearing = P.camera_yaw - std::atan(d.x_t);
   d.photo = m.database_photo;
   d.elevation = elevationOf(off, K, P.camera_pitch);
