@@ -429,10 +429,11 @@ TEST_F(RecognitionStage, FindsAHeldOutViewThatMatchingAloneMisses) {
   EXPECT_EQ(reported_with_unknown, reported);
 }
 
-// The servo error a detection gives (x_t - x_d) is the carton's own offset from the image
-// centre, wherever the carton sits in the database photo it matched. A user's photo frames the
-// landmark anywhere (held in a hand, on a shelf); the paper's median of x_t - x_d
-// (paper_offset) places the photo's centre instead, off by the carton's offset in the photo.
+// With paper_offset off, the servo error a detection gives (x_t - x_d) is the carton's own
+// offset from the image centre, wherever the carton sits in the database photo it matched. A
+// user's photo frames the landmark anywhere (held in a hand, on a shelf); the paper's median of
+// x_t - x_d (paper_offset on, the default) places the photo's centre instead, off by the
+// carton's offset in the photo.
 // The model here knows each carton only from photos that show it off-centre, left or right
 // (its catalogue artwork in clutter: this checks the geometry, not recognition of unseen views).
 TEST(ServoError, IsTheCartonsOffsetWhereverItSitsInThePhoto) {
@@ -461,6 +462,7 @@ TEST(ServoError, IsTheCartonsOffsetWhereverItSitsInThePhoto) {
       PerceptionParams p;
       p.fovea = false;
       p.track.enabled = false;
+      p.paper_offset = false;
       Detection d;
       if (countClass(LandmarkPerception(model, p).observe(f, K, {cls}), cls, &d) == 0) continue;
       ++detections;
