@@ -419,7 +419,10 @@ TEST_F(RosTest, ALockstepRunRecordedWithRosbagReplaysToItsCommands) {
   ASSERT_EQ(nav_->exitCode(), 0) << logs();
   record.signal(SIGINT);
   ASSERT_TRUE(record.wait(20)) << record.err();
-  ASSERT_TRUE(fs::exists(bag)) << record.err();
+  // `rosbag` (Python) passes SIGINT on to its `record` child and exits at once; the child
+  // closes the bag (run.bag.active -> run.bag) on its own time.
+  ASSERT_TRUE(waitFor([&] { return fs::exists(bag) && !fs::exists(bag + ".active"); }, 30))
+      << record.err();
   sim_->signal(SIGINT);
   ASSERT_TRUE(sim_->wait(10));
   const Json s = Json::parse(sim_->out());
