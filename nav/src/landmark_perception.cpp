@@ -467,10 +467,14 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
     const cv::Rect crop(x0, (img.rows - ch) / 2, cw, ch);
     scale = std::min(scale, static_cast<double>(P.fovea_max_side) / std::max(cw, ch));
     cv::Mat patch = img(crop);
-    if (std::abs(scale - 1) > 1e-3) {
+    // Resized to a whole-pixel size, so the pixels depend on that size alone: cv::resize given a
+    // factor interpolates with the factor itself, which follows the predicted range
+    // continuously (a replay's pose, 1e-7 m off the run's, gave other keypoints).
+    const cv::Size to(std::max(1, static_cast<int>(std::lround(cw * scale))),
+                      std::max(1, static_cast<int>(std::lround(ch * scale))));
+    if (to != crop.size()) {
       cv::Mat resized;
-      cv::resize(patch, resized, cv::Size(), scale, scale,
-                 scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
+      cv::resize(patch, resized, to, 0, 0, scale > 1 ? cv::INTER_LINEAR : cv::INTER_AREA);
       patch = resized;
     }
     ++ob.timing.fovea_looks;

@@ -168,6 +168,30 @@ TEST_F(FoveaTest, FindsASmallLandmarkWhereTheHintPointsWithItsFullFrameBearing) 
   }
 }
 
+// The second look's view depends on the whole-pixel size of its upscaled crop, not on the exact
+// predicted range: a range a hair different (a replay's pose is ~1e-7 m off the run's, through
+// float32 scan angles) gives the same crop size and so the same detection to the last digit.
+TEST_F(FoveaTest, TheSecondLookIsTheSameForARangeAHairDifferent) {
+  const cv::Mat photo = cv::imread(iconic(kTarget));
+  ASSERT_FALSE(photo.empty());
+  hw::Frame f;
+  f.image = sceneWith(photo, 80, 300, 210, 11);
+  const double bearing = bearingOf(300);
+  Detection a, b;
+  LandmarkPerception one(model_, params(true)), other(model_, params(true));
+  ASSERT_EQ(
+      countClass(one.observe(f, K, std::vector<LookFor>{{kTarget, bearing, 3.0}}), kTarget, &a), 1);
+  // 3.0001 m: the upscale 1.50005 instead of 1.5; the 256 x 320 px crop becomes 384 x 480 px
+  // either way.
+  ASSERT_EQ(countClass(other.observe(f, K, std::vector<LookFor>{{kTarget, bearing, 3.0001}}),
+                       kTarget, &b),
+            1);
+  EXPECT_EQ(a.inliers, b.inliers);
+  EXPECT_DOUBLE_EQ(a.x_t, b.x_t);
+  EXPECT_DOUBLE_EQ(a.x_d, b.x_d);
+  EXPECT_EQ(a.window, b.window);
+}
+
 TEST_F(FoveaTest, NotFoundWhereTheHintDoesNotPoint) {
   const cv::Mat photo = cv::imread(iconic(kTarget));
   ASSERT_FALSE(photo.empty());
