@@ -189,8 +189,12 @@ struct RosWorld {
   std::unique_ptr<ros::AsyncSpinner> spinner;
   std::string error;  // why it could not be made
 };
-RosWorld& world() {
+RosWorld& worldState() {
   static RosWorld w;
+  return w;
+}
+RosWorld& world() {
+  RosWorld& w = worldState();
   if (w.nh || !w.error.empty()) return w;
   w.dir = fs::temp_directory_path() / ("sketchnav-test-ros-" + std::to_string(::getpid()));
   fs::create_directories(w.dir / "roshome");
@@ -220,6 +224,23 @@ RosWorld& world() {
   w.spinner->start();
   return w;
 }
+
+// Ends the ROS world when the tests are done, before static destruction: roscpp's own statics
+// may be gone by the time a static RosWorld would destroy its NodeHandle (AddressSanitizer,
+// debug-asan preset: a heap-use-after-free in ros::ServiceManager at exit).
+class RosWorldTeardown : public ::testing::Environment {
+ public:
+  void TearDown() override {
+    RosWorld& w = worldState();  // as made, if a test made it
+    if (w.spinner) w.spinner->stop();
+    w.spinner.reset();
+    w.nh.reset();
+    if (ros::isStarted()) ros::shutdown();
+    w.master.reset();  // SIGKILL of the master
+  }
+};
+[[maybe_unused]] ::testing::Environment* const kRosWorldTeardown =
+    ::testing::AddGlobalTestEnvironment(new RosWorldTeardown);
 
 class RosTest : public ::testing::Test {
  protected:
