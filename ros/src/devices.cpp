@@ -29,6 +29,7 @@
 namespace sketchnav::ros {
 namespace {
 using detail::Input;
+using detail::InputKind;
 using detail::State;
 using detail::state;
 using detail::wallNow;
@@ -64,7 +65,8 @@ PoseFault poseFault(const Point& p, const Quaternion& q, std::initializer_list<d
 }
 
 // Fills in what the watchdog needs once the subscription exists (before addInput()).
-void describe(Input& in, const std::string& what, const ::ros::Subscriber& sub) {
+void describe(Input& in, InputKind kind, const std::string& what, const ::ros::Subscriber& sub) {
+  in.kind = kind;
   in.what = what;
   in.topic = sub.getTopic();
   ::ros::Subscriber copy = sub;
@@ -107,7 +109,7 @@ class RosCamera final : public hw::Camera {
     else
       sub_ = nh.subscribe(topic, 2, &RosCamera::onImage, this);
     if (!info_topic.empty()) info_sub_ = nh.subscribe(info_topic, 2, &RosCamera::onInfo, this);
-    describe(*in_, "camera", sub_);
+    describe(*in_, InputKind::Camera, "camera", sub_);
     uri_ = "ros://camera?topic=" + sub_.getTopic();
     waitFirst(
         [this] {
@@ -296,13 +298,14 @@ class RosBase final : public hw::Base {
     }
     if (!odom_topic.empty()) {
       sub_ = nh.subscribe(odom_topic, 10, &RosBase::onOdom, this);
-      describe(*in_, "odometry", sub_);
+      describe(*in_, InputKind::Odometry, "odometry", sub_);
       uri_ = "ros://base?cmd_vel=" + pub_.getTopic() + "&odom=" + sub_.getTopic();
     } else {
       odom_frame_ = strip(odom_frame);
       base_frame_ = strip(state().params.base_frame);
       sub_ = nh.subscribe("/tf", 100, &RosBase::onTf, this);
-      describe(*in_, "odometry (tf " + odom_frame_ + " -> " + base_frame_ + ")", sub_);
+      describe(*in_, InputKind::Odometry,
+               "odometry (tf " + odom_frame_ + " -> " + base_frame_ + ")", sub_);
       uri_ = "ros://base?cmd_vel=" + pub_.getTopic() + "&tf=" + odom_frame_;
     }
     waitFirst(
@@ -526,7 +529,7 @@ class RosLaser final : public hw::RangeSensor {
  public:
   explicit RosLaser(const std::string& topic) {
     sub_ = detail::nodeHandle().subscribe(topic, 5, &RosLaser::onScan, this);
-    describe(*in_, "laser scan", sub_);
+    describe(*in_, InputKind::Laser, "laser scan", sub_);
     uri_ = "ros://laser?topic=" + sub_.getTopic();
     waitFirst(
         [this] {
@@ -633,7 +636,7 @@ class RosSonar final : public hw::RangeSensor {
  public:
   explicit RosSonar(const std::string& topic) {
     sub_ = detail::nodeHandle().subscribe(topic, 50, &RosSonar::onRange, this);
-    describe(*in_, "sonar", sub_);
+    describe(*in_, InputKind::Sonar, "sonar", sub_);
     uri_ = "ros://sonar?topic=" + sub_.getTopic();
     waitFirst(
         [this] {

@@ -21,8 +21,12 @@
 
 namespace sketchnav::ros::detail {
 
+/// What a subscribed stream carries (the lock-step step message lists a stamp per kind).
+enum class InputKind { Camera, Odometry, Laser, Sonar };
+
 /// One subscribed stream the watchdog judges.
 struct Input {
+  InputKind kind = InputKind::Camera;
   std::string what;                     // "camera", "odometry", "laser scan", "sonar"
   std::string topic;                    // resolved name
   std::atomic<double> wall_last{-1.0};  // [s] wallNow() of the last message, -1 before the first

@@ -269,12 +269,18 @@ void livenessLoop() {
 }
 
 // Lock-step (RosParams::lockstep): which entry of the simulator's step message holds the
-// stamp an input must have reached; -1 for inputs the step does not describe.
-int stepIndex(const std::string& what) {
-  if (what == "camera") return 4;
-  if (what.rfind("odometry", 0) == 0) return 1;
-  if (what == "laser scan") return 2;
-  if (what == "sonar") return 3;
+// stamp an input must have reached.
+int stepIndex(detail::InputKind kind) {
+  switch (kind) {
+    case detail::InputKind::Odometry:
+      return 1;
+    case detail::InputKind::Laser:
+      return 2;
+    case detail::InputKind::Sonar:
+      return 3;
+    case detail::InputKind::Camera:
+      return 4;
+  }
   return -1;
 }
 
@@ -292,7 +298,7 @@ double lockstepNow() {
   if (s.step.size() >= 5 && s.step[0] > s.lockstep_now) {
     bool ready = true;
     for (const auto& in : inputs) {
-      const int k = stepIndex(in->what);
+      const int k = stepIndex(in->kind);
       if (k < 0 || !in->active || s.step[k] < 0) continue;
       // Stamps travel as ROS times (nanoseconds): equal within a microsecond.
       if (in->stamp_last < s.step[k] - 1e-6) ready = false;
