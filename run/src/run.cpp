@@ -509,14 +509,15 @@ Json runNavigation(const RunOptions& o) {
     // A recording without run info (a bag recorded beside a ROS robot) may still show the
     // camera's mount in its tf, as `ros nav` took it live (readRecordedRobot).
     const Json info = drivers::readRunInfo(o.replay);
-    const Json robot = drivers::readRecordedRobot(o.replay);
+    std::optional<Json> robot;  // read only when the run info lacks a key (another bag scan)
     const auto take = [&](const std::string& key, double& v) {
       std::string k = key;
       for (const auto& [old_key, new_key] : cameraMountRenames())
         if (new_key == key && !info.contains(key) && info.contains(old_key)) k = old_key;
       if (o.config.has(key)) return;
       const bool recorded = info.contains(k);
-      const Json& from = recorded ? info : robot;
+      if (!recorded && !robot) robot = drivers::readRecordedRobot(o.replay);
+      const Json& from = recorded ? info : *robot;
       if (!from.contains(k)) return;
       if (!from[k].is_number())
         throw InputError("--replay " + o.replay + ": " + (recorded ? "run info" : "recorded tf") +
