@@ -153,6 +153,7 @@ TEST(DistinctMatch, ArtworkSharedWithAnotherClassIsNoEvidence) {
   mp.kmeans_iterations = 5;
   const LandmarkModel model = trainModel(root, mp);
   MatchParams off, on;
+  off.distinct_min_fraction = 0;
   on.distinct_min_fraction = 0.3;
   int unknown_off = 0, unknown_on = 0, a_on = 0, a_off = 0;
   for (unsigned s = 0; s < 4; ++s) {

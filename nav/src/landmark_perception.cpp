@@ -21,11 +21,6 @@ namespace sketchnav::nav {
 void PerceptionParams::validate() const {
   require(max_windows >= 1 && max_windows <= 1000, "nav.perception.max_windows",
           "must be in [1, 1000]");
-  require(min_inliers >= 4, "nav.perception.min_inliers", "must be >= 4 (a homography)");
-  require(ratio > 0 && ratio < 1, "nav.perception.ratio", "must be in (0, 1)");
-  require(max_photos >= 1, "nav.perception.max_photos", "must be >= 1");
-  require(distinct_min_fraction >= 0 && distinct_min_fraction <= 1,
-          "nav.perception.distinct_min_fraction", "must be in [0, 1] (0 = off)");
   require(merge_iou > 0 && merge_iou <= 1, "nav.perception.merge_iou", "must be in (0, 1]");
   require(frame_max_side >= 64, "nav.perception.frame_max_side", "must be >= 64 px");
   require(frame_max_features >= 0, "nav.perception.frame_max_features", "must be >= 0");
@@ -43,8 +38,9 @@ void PerceptionParams::validate() const {
   require(fovea_max_looks >= 0, "nav.perception.fovea_max_looks", "must be >= 0");
   require(recognise_windows >= 0 && recognise_windows <= max_windows,
           "nav.perception.recognise_windows", "must be in [0, max_windows]");
-  require(position_min_inliers >= 4 && position_min_inliers <= min_inliers,
-          "nav.perception.position_min_inliers", "must be in [4, min_inliers] (a homography)");
+  require(position_min_inliers >= 4 && position_min_inliers <= match.min_inliers,
+          "nav.perception.position_min_inliers",
+          "must be in [4, landmarks.match.min_inliers] (a homography)");
   require(window_side >= 64 && window_side <= 1024, "nav.perception.window_side",
           "must be in [64, 1024] px");
   require(window_margin >= 0 && window_margin <= 1, "nav.perception.window_margin",
@@ -56,6 +52,7 @@ void PerceptionParams::validate() const {
           "nav.perception.tilt_confirm_frames", "must be in [0, 100] (observe() calls)");
   require(threads >= 1 && threads <= 2, "nav.perception.threads",
           "must be 1 or 2 (the stages that run side by side)");
+  match.validate();
   track.validate();
   recognition.validate();
   objectness.validate();
@@ -65,6 +62,11 @@ PerceptionParams perceptionParamsFrom(const Config& config) {
   PerceptionParams p;
   applyConfig(p, config, "nav.perception");
   p.setCamera(cameraMountFrom(config));
+  // The matching rule had names of its own under nav.perception until it became one with
+  // `recognise --match`'s: an old config or summary.json is told where each went.
+  for (const char* k : {"ratio", "min_inliers", "max_photos", "distinct_min_fraction"})
+    config.markMoved(std::string("nav.perception.") + k, std::string("landmarks.match.") + k);
+  applyConfig(p.match, config, "landmarks.match");
   applyConfig(p.track, config, "nav.perception.track");
   applyConfig(p.recognition, config, "landmarks.recognition");
   p.objectness = landmarks::objectnessParamsFrom(config);
@@ -129,15 +131,6 @@ double iou(const cv::Rect& a, const cv::Rect& b) {
   const double i = (a & b).area();
   const double u = a.area() + b.area() - i;
   return u > 0 ? i / u : 0;
-}
-
-landmarks::MatchParams matchParams(const PerceptionParams& P) {
-  landmarks::MatchParams mp;
-  mp.ratio = P.ratio;
-  mp.min_inliers = P.min_inliers;
-  mp.max_photos = P.max_photos;
-  mp.distinct_min_fraction = P.distinct_min_fraction;
-  return mp;
 }
 
 // Elevation [rad] above the camera's horizontal plane of the matched object's centre (the
@@ -232,7 +225,7 @@ bool examineView(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   if (recs.empty() || recs[0].empty() || recs[0][0].rejected) return false;
   const auto& r = recs[0][0];
   if (std::find(classes.begin(), classes.end(), r.class_name) == classes.end()) return false;
-  landmarks::MatchParams mp = matchParams(P);
+  landmarks::MatchParams mp = P.match;
   auto m = landmarks::match(model, feats, cv::Rect(), r.class_name, mp);
   if (!m.matched) {
     mp.min_inliers = P.position_min_inliers;
@@ -247,7 +240,7 @@ bool examineView(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   // may hold much more than the landmark), and a wrong bearing misleads the route refit.
   if (!placed) return false;
   d.inliers = std::max(d.inliers, r.inliers);
-  d.recognised_only = d.inliers < P.min_inliers;
+  d.recognised_only = d.inliers < P.match.min_inliers;
   // A homography from fewer than min_inliers inliers places the landmark's column but not
   // the photo's centre well enough to range it by its elevation.
   if (d.recognised_only) d.elevation = NAN;
@@ -390,7 +383,7 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
   for (const auto& w : windows) ob.windows.push_back(w.box);
 
   t = clk::now();
-  const landmarks::MatchParams mp = matchParams(P);
+  const landmarks::MatchParams mp = P.match;
   std::vector<cv::Rect> boxes;
   for (const auto& w : windows) boxes.push_back(w.box);
   if (P.whole_frame) boxes.push_back(cv::Rect());  // empty = the whole frame
@@ -434,7 +427,7 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
 
   const auto tf = clk::now();
   const cv::Mat& img = frame.image;
-  const landmarks::MatchParams mp = matchParams(P);
+  const landmarks::MatchParams mp = P.match;
   std::vector<std::string> looked;  // one second look per class
   for (const auto& l : look_for) {
     if (!std::isfinite(l.bearing) || model.classId(l.class_name) < 0) continue;
@@ -502,7 +495,7 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
     // The window drawn for it: the matched keypoints' extent, inside the crop.
     const cv::Rect box = cv::boundingRect(m.x_t) & crop;
     if (!toDetection(m, l.class_name, box.area() > 0 ? box : crop, img.cols, K, P, d)) continue;
-    d.recognised_only = d.inliers < P.min_inliers;
+    d.recognised_only = d.inliers < P.match.min_inliers;
     if (d.recognised_only) d.elevation = NAN;  // as in examineCrop()
     ob.detections.push_back(d);
   }

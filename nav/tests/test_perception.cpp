@@ -148,7 +148,7 @@ TEST_F(FoveaTest, FindsASmallLandmarkWhereTheHintPointsWithItsFullFrameBearing) 
     EXPECT_GE(ob.timing.total_ms, ob.timing.fovea_ms);
     Detection d;
     ASSERT_EQ(countClass(ob, kTarget, &d), 1);
-    EXPECT_GE(d.inliers, params(true).min_inliers);
+    EXPECT_GE(d.inliers, params(true).match.min_inliers);
     EXPECT_NEAR(d.bearing, bearing, 3.0 / K.fx);  // within 3 px
     EXPECT_NEAR(d.x_t, K.normalisedX(u), 3.0 / K.fx);
     EXPECT_NEAR(d.x_d, K.normalisedX(u) - (u - 320) / K.fx, 3.0 / K.fx);  // centred photo
@@ -695,6 +695,36 @@ TEST(PerceptionParamsTest, RecognitionFieldsAreValidated) {
   p = PerceptionParams{};
   p.tilt_confirm_frames = -1;
   EXPECT_THROW(p.validate(), InputError);
+}
+
+// One name per quantity: the loop's matching rule is "landmarks.match.*", the settings
+// `recognise --match` reads, with the same defaults; the recognition stage verifies without the
+// distinct-inlier check (its sibling check decides between look-alikes).
+TEST(PerceptionParamsTest, TheMatchingRuleIsLandmarksMatch) {
+  const landmarks::MatchParams lib;
+  const PerceptionParams def;
+  EXPECT_EQ(paramsToJson(def.match), paramsToJson(lib));
+  EXPECT_DOUBLE_EQ(def.match.distinct_min_fraction, 0.3);
+  EXPECT_DOUBLE_EQ(def.recognition.match.distinct_min_fraction, 0);
+
+  Config c;
+  c.set("landmarks.match.min_inliers=15");
+  c.set("landmarks.match.ransac_px=4");
+  const PerceptionParams p = perceptionParamsFrom(c);
+  EXPECT_EQ(p.match.min_inliers, 15);
+  EXPECT_DOUBLE_EQ(p.match.ransac_px, 4);
+  EXPECT_NO_THROW(c.requireAllUsed());
+
+  Config old;
+  old.set("nav.perception.min_inliers=15");
+  EXPECT_EQ(perceptionParamsFrom(old).match.min_inliers, 12);  // not read under the old name
+  try {
+    old.requireAllUsed();
+    FAIL() << "the old name was accepted";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("'landmarks.match.min_inliers' now"), std::string::npos)
+        << e.what();
+  }
 }
 
 }  // namespace

@@ -320,6 +320,7 @@ Json runSettingsJson(const RunSettings& r, bool with_sim) {
   j["route"] = paramsToJson(r.route);
   j["landmarks"]["train"] = paramsToJson(r.train);
   j["landmarks"]["recognition"] = paramsToJson(r.perception.recognition);
+  j["landmarks"]["match"] = paramsToJson(r.perception.match);
   Json n = paramsToJson(r.nav.exec);
   n["sections"] = paramsToJson(r.nav.sections);
   n["select"] = paramsToJson(r.nav.select);

@@ -10,9 +10,16 @@ expect(2 "unknown setting 'route.simplify_tolerence' .did you mean 'route.simpli
 run_ok(out err route ${LAB} --set route.simplify_tolerance=0.03)
 expect(2 "--set servo.lamda: unknown setting 'servo.lamda' .did you mean 'servo.lambda'"
        run --set servo.lamda=0.1 --out ${WORK}/run-typo)
-file(WRITE ${WORK}/typo.json "{\"nav\": {\"perception\": {\"ratoi\": 0.7}}}")
-expect(2 "${WORK}/typo.json: unknown setting 'nav.perception.ratoi' .did you mean 'nav.perception.ratio'"
+file(WRITE ${WORK}/typo.json "{\"nav\": {\"perception\": {\"fovae\": false}}}")
+expect(2 "${WORK}/typo.json: unknown setting 'nav.perception.fovae' .did you mean 'nav.perception.fovea'"
        --config ${WORK}/typo.json run --out ${WORK}/run-typo2)
+# A setting that was renamed (one name per quantity: the navigation's matching rule is
+# recognise --match's) names its new key, from --config as from --set.
+file(WRITE ${WORK}/moved.json "{\"nav\": {\"perception\": {\"min_inliers\": 14}}}")
+expect(2 "${WORK}/moved.json: unknown setting 'nav.perception.min_inliers' .it is called 'landmarks.match.min_inliers' now"
+       --config ${WORK}/moved.json run --out ${WORK}/run-moved)
+expect(2 "unknown setting 'landmarks.match.min_inlers' .did you mean 'landmarks.match.min_inliers'"
+       run --set landmarks.match.min_inlers=14 --out ${WORK}/run-moved2)
 # Objectness settings reach run (a valid one passes the check; the bad value is then refused).
 expect(2 "objectness.nms_iou" run --set objectness.nms_iou=7 --out ${WORK}/run-objn)
 expect(2 "unknown setting 'landmarks.train.vocabulary_sise' .did you mean 'landmarks.train.vocabulary_size'"

@@ -15,11 +15,12 @@ function(run_any dir)
   set(summary "${s}" PARENT_SCOPE)
 endfunction()
 
-run_any(${WORK}/a run --seed 2 --max-time 3 --set servo.lambda=0.6 --set objectness.nms_iou=0.6)
+run_any(${WORK}/a run --seed 2 --max-time 3 --set servo.lambda=0.6 --set objectness.nms_iou=0.6
+        --set landmarks.match.min_inliers=14)
 set(first "${summary}")
 string(JSON settings GET "${first}" settings)
 foreach(key nav.select nav.locate nav.planner nav.movers nav.goal_door route sim objectness
-            nav.perception landmarks.recognition landmarks.train servo)
+            nav.perception landmarks.recognition landmarks.match landmarks.train servo)
   string(REPLACE "." ";" path "${key}")
   string(JSON t ERROR_VARIABLE e TYPE "${settings}" ${path})
   if(NOT t STREQUAL "OBJECT")
@@ -30,9 +31,12 @@ string(JSON seed GET "${settings}" sim seed)
 string(JSON lambda GET "${settings}" servo lambda)
 string(JSON max_time GET "${settings}" nav max_time_s)
 string(JSON nms GET "${settings}" objectness nms_iou)
-if(NOT seed EQUAL 2 OR NOT lambda EQUAL 0.6 OR NOT max_time EQUAL 3 OR NOT nms EQUAL 0.6)
+string(JSON inliers GET "${settings}" landmarks match min_inliers)
+if(NOT seed EQUAL 2 OR NOT lambda EQUAL 0.6 OR NOT max_time EQUAL 3 OR NOT nms EQUAL 0.6
+   OR NOT inliers EQUAL 14)
   message(FATAL_ERROR "summary settings are not the run's: seed ${seed}, lambda ${lambda}, "
-                      "max_time_s ${max_time}, objectness.nms_iou ${nms}")
+                      "max_time_s ${max_time}, objectness.nms_iou ${nms}, "
+                      "landmarks.match.min_inliers ${inliers}")
 endif()
 file(WRITE ${WORK}/settings.json "${settings}")
 

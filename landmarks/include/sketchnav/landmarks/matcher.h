@@ -50,8 +50,9 @@ struct MatchParams {
   // descriptor of any other class (one approximate search of the whole database per frame,
   // distinct_neighbours neighbours, distinct_checks leaves). Artwork shared by sibling products
   // (a brand's logo) gives inliers that are not distinct: not matched when fewer than
-  // distinct_min_fraction of the inliers are distinct. 0 = off.
-  double distinct_min_fraction = 0;
+  // distinct_min_fraction of the inliers are distinct. In [0, 1]; 0 = off. The evidence for the
+  // default: doc/perception-benchmark.md "Distinct inliers and tracking".
+  double distinct_min_fraction = 0.3;
   double distinct_ratio = 0.9;   // in (0, 1]
   int distinct_neighbours = 12;  // database neighbours searched per frame keypoint, >= 2
   int distinct_checks = 32;      // kd-tree leaves checked in that search, >= 1

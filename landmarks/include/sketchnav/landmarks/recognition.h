@@ -109,7 +109,14 @@ struct RecognitionParams {
   bool sibling_check = true;
   double sibling_vote_ratio = 0.7;
   double sibling_margin = 0.1;
-  MatchParams match;  // verification settings (min_inliers is the reject threshold)
+  // Verification settings (min_inliers is the reject threshold). The distinct-inlier check is
+  // off here: the sibling check above decides between look-alikes. The navigation's matching
+  // stage and `recognise --match` use "landmarks.match.*" (MatchParams), where it is on.
+  MatchParams match = [] {
+    MatchParams m;
+    m.distinct_min_fraction = 0;
+    return m;
+  }();
 
   template <class B>
   void bind(B& b) {

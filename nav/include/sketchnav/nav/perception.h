@@ -99,14 +99,6 @@ class Perception {
 struct PerceptionParams {
   int max_windows = 30;      // objectness windows examined per frame
   bool whole_frame = false;  // also match the whole frame (when objectness misses)
-  int min_inliers = 12;      // RANSAC inliers for a detection (never a guess below)
-  double ratio = 0.8;        // Lowe ratio test
-  int max_photos = 3;        // database photos tried per window
-  // Fraction of a match's inliers that must be distinct: closer to the class's photo than
-  // landmarks::MatchParams::distinct_ratio x the nearest descriptor of any other class (artwork
-  // a sibling product shares is not evidence for either). In [0, 1]; 0 = off. The evidence for
-  // the default: doc/perception-benchmark.md "Distinct inliers".
-  double distinct_min_fraction = 0.3;
   // The servo error x_t - x_d a detection gives. true: the paper's median over inliers of
   // (x_t - x_d), each measured from its own image's centre, which places the database photo's
   // centre: the object only when the photo shows it centred. false: the matched object's
@@ -189,6 +181,10 @@ struct PerceptionParams {
   // the calling thread. The detections are the same for any count (only the wall time
   // changes); evidence: doc/perception-benchmark.md "Two cores".
   int threads = 2;
+  // The matching stage's rule ("landmarks.match.*", the same settings `recognise --match`
+  // reads): Lowe's ratio, RANSAC, min_inliers for a detection (never a guess below), database
+  // photos tried per window, the colour and distinct-inlier checks.
+  landmarks::MatchParams match;
   TrackParams track;                         // "nav.perception.track.*" (detect, then track)
   landmarks::RecognitionParams recognition;  // "landmarks.recognition.*"
   landmarks::ObjectnessParams objectness;    // "objectness.*" (the windows proposed per frame)
@@ -196,10 +192,6 @@ struct PerceptionParams {
   void bind(B& b) {
     b("max_windows", max_windows);
     b("whole_frame", whole_frame);
-    b("min_inliers", min_inliers);
-    b("ratio", ratio);
-    b("max_photos", max_photos);
-    b("distinct_min_fraction", distinct_min_fraction);
     b("paper_offset", paper_offset);
     b("merge_iou", merge_iou);
     b("frame_max_side", frame_max_side);
@@ -233,9 +225,9 @@ struct PerceptionParams {
 };
 
 /// The perception settings of a run or replay from `config`: "nav.perception.*", with its
-/// recognition settings from "landmarks.recognition.*", its tracking from
-/// "nav.perception.track.*" and its objectness from "objectness.*";
-/// validated. One assembly for `run`, `replay` and `replay --eval`.
+/// matching rule from "landmarks.match.*", its recognition settings from "landmarks.recognition.*",
+/// its tracking from "nav.perception.track.*" and its objectness from "objectness.*"; validated.
+/// One assembly for `run`, `replay` and `replay --eval`.
 PerceptionParams perceptionParamsFrom(const Config& config);
 
 /// Objectness + RootSIFT matching on the landmark model; between full passes (every
