@@ -101,14 +101,8 @@ std::vector<std::string> Config::knownKeys() const {
   return {usage_->known.begin(), usage_->known.end()};
 }
 
-void Config::markMoved(const std::string& old_key, const std::string& new_key) const {
-  usage_->moved[old_key] = new_key;
-}
-
 std::string Config::unknownSettingMessage(const std::string& key) const {
   std::string msg = origin(key) + ": unknown setting '" + key + "'";
-  if (const auto m = usage_->moved.find(key); m != usage_->moved.end())
-    return msg + " (it is called '" + m->second + "' now)";
   const std::string best = closestKey(key, knownKeys());
   if (!best.empty())
     msg += " (did you mean '" + best + "'?)";

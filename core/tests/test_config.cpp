@@ -143,22 +143,6 @@ TEST(Config, UnknownSettingNamesTheClosestKnownKey) {
   }
 }
 
-TEST(Config, AMovedSettingNamesItsNewKey) {
-  Config c;
-  c.set("old.lambda=0.3");
-  c.markMoved("old.lambda", "demo.lambda");
-  DemoParams p;
-  applyConfig(p, c, "demo");
-  EXPECT_DOUBLE_EQ(p.lambda, 0.5);  // the old key is not read
-  try {
-    c.requireAllUsed();
-    FAIL() << "a moved setting was accepted";
-  } catch (const InputError& e) {
-    EXPECT_EQ(std::string(e.what()),
-              "--set old.lambda: unknown setting 'old.lambda' (it is called 'demo.lambda' now)");
-  }
-}
-
 TEST(Config, UnknownSettingFromAFileNamesTheFile) {
   Config c = Config::fromJson(Json{{"demo", {{"window_cont", 3}}}}, "my.json");
   DemoParams p;

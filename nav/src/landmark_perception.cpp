@@ -62,10 +62,9 @@ PerceptionParams perceptionParamsFrom(const Config& config) {
   PerceptionParams p;
   applyConfig(p, config, "nav.perception");
   p.setCamera(cameraMountFrom(config));
-  // The matching rule had names of its own under nav.perception until it became one with
-  // `recognise --match`'s: an old config or summary.json is told where each went.
   for (const char* k : {"ratio", "min_inliers", "max_photos", "distinct_min_fraction"})
-    config.markMoved(std::string("nav.perception.") + k, std::string("landmarks.match.") + k);
+    rejectRenamed(config, std::string("nav.perception.") + k, std::string("landmarks.match.") + k,
+                  "the navigation's matching rule is the one recognise --match uses");
   applyConfig(p.match, config, "landmarks.match");
   applyConfig(p.track, config, "nav.perception.track");
   applyConfig(p.recognition, config, "landmarks.recognition");

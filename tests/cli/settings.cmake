@@ -16,7 +16,7 @@ expect(2 "${WORK}/typo.json: unknown setting 'nav.perception.fovae' .did you mea
 # A setting that was renamed (one name per quantity: the navigation's matching rule is
 # recognise --match's) names its new key, from --config as from --set.
 file(WRITE ${WORK}/moved.json "{\"nav\": {\"perception\": {\"min_inliers\": 14}}}")
-expect(2 "${WORK}/moved.json: unknown setting 'nav.perception.min_inliers' .it is called 'landmarks.match.min_inliers' now"
+expect(2 "${WORK}/moved.json: setting 'nav.perception.min_inliers' is now 'landmarks.match.min_inliers'"
        --config ${WORK}/moved.json run --out ${WORK}/run-moved)
 expect(2 "unknown setting 'landmarks.match.min_inlers' .did you mean 'landmarks.match.min_inliers'"
        run --set landmarks.match.min_inlers=14 --out ${WORK}/run-moved2)

@@ -47,9 +47,6 @@ class Config {
   /// "did you mean" of requireAllUsed().
   void markKnown(const std::string& key) const;
   std::vector<std::string> unusedKeys(const std::string& prefix = "") const;
-  /// Records that the setting `old_key` is now called `new_key`: an unused `old_key` is then
-  /// reported as moved, naming the new key, rather than with the closest known one.
-  void markMoved(const std::string& old_key, const std::string& new_key) const;
   /// Every key recorded by markKnown() / markUsed() so far, sorted.
   std::vector<std::string> knownKeys() const;
   /// The one-line error for an unused key: "<origin>: unknown setting 'servo.lamda' (did you
@@ -69,7 +66,6 @@ class Config {
   std::map<std::string, std::string> origins_;
   struct Usage {
     std::set<std::string> used, known;
-    std::map<std::string, std::string> moved;  // old key -> new key
   };
   std::shared_ptr<Usage> usage_ = std::make_shared<Usage>();
 };
