@@ -618,9 +618,9 @@ void registerBagDevices() {
                return std::make_unique<BagRange>(u, ctx.clock);
              },
              {"kind", "topic"});
-  drivers::registerRecorder(
-      ".bag", [](const std::string& path) { return std::make_shared<BagRecorder>(path); });
-  drivers::registerRunInfoReader(".bag", [](const std::string& path) -> Json {
+  drivers::RecordingFormat bag_format;
+  bag_format.open = [](const std::string& path) { return std::make_shared<BagRecorder>(path); };
+  bag_format.run_info = [](const std::string& path) -> Json {
     rosbag::Bag bag;
     openToRead(bag, path);
     rosbag::View v(bag, rosbag::TopicQuery(kRunInfoTopic));
@@ -631,8 +631,8 @@ void registerBagDevices() {
         return j;
       }
     return Json::object();
-  });
-  drivers::registerRecordedRobotReader(".bag", [](const std::string& path) -> Json {
+  };
+  bag_format.robot = [](const std::string& path) -> Json {
     rosbag::Bag bag;
     openToRead(bag, path);
     // The optical frame of the bag's first image, raw or compressed.
@@ -654,7 +654,8 @@ void registerBagDevices() {
                 {"robot.camera.z_m", c.z_m},
                 {"robot.camera.yaw", c.yaw},
                 {"robot.camera.pitch", c.pitch}};
-  });
+  };
+  drivers::registerRecordingFormat(".bag", std::move(bag_format));
 }
 
 }  // namespace sketchnav::ros

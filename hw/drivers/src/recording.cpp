@@ -4,6 +4,7 @@
 #include <filesystem>
 #include <map>
 #include <mutex>
+#include <optional>
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/input_file.h"
@@ -36,15 +37,21 @@ class RawlogSink final : public Recorder {
   std::shared_ptr<RawlogRecorder> r_;
 };
 
-struct Recorders {
+struct Formats {
   std::mutex m;
-  std::map<std::string, RecorderFactory> by_extension;
-  std::map<std::string, RunInfoReader> info_by_extension;
-  std::map<std::string, RunInfoReader> robot_by_extension;
+  std::map<std::string, RecordingFormat> by_extension;
 };
-Recorders& recorders() {
-  static Recorders r;
+Formats& formats() {
+  static Formats r;
   return r;
+}
+// The registered format of `path`'s extension, if any (a copy: used outside the lock).
+std::optional<RecordingFormat> formatOf(const std::string& path) {
+  auto& f = formats();
+  std::lock_guard<std::mutex> l(f.m);
+  const auto it = f.by_extension.find(std::filesystem::path(path).extension().string());
+  if (it == f.by_extension.end()) return std::nullopt;
+  return it->second;
 }
 
 // Shared by the three decorators: the first write error turns recording off (logged once), so a
@@ -130,59 +137,28 @@ std::shared_ptr<Recorder> rawlogRecorder(std::shared_ptr<RawlogRecorder> rawlog)
   return std::make_shared<RawlogSink>(std::move(rawlog));
 }
 
-void registerRecorder(const std::string& extension, RecorderFactory factory) {
-  auto& r = recorders();
-  std::lock_guard<std::mutex> l(r.m);
-  r.by_extension[extension] = std::move(factory);
+void registerRecordingFormat(const std::string& extension, RecordingFormat format) {
+  auto& f = formats();
+  std::lock_guard<std::mutex> l(f.m);
+  f.by_extension[extension] = std::move(format);
 }
 
 std::shared_ptr<Recorder> openRecorder(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  {
-    auto& r = recorders();
-    std::lock_guard<std::mutex> l(r.m);
-    const auto it = r.by_extension.find(ext);
-    if (it != r.by_extension.end()) return it->second(path);
-  }
-  if (ext == ".bag")
+  if (const auto f = formatOf(path); f && f->open) return f->open(path);
+  if (std::filesystem::path(path).extension() == ".bag")
     throw InputError("--record " + path +
                      ": this sketchnav was built without ROS, so it cannot write bags "
                      "(record a .rawlog, or build with the ROS packages: bootstrap.sh)");
   return rawlogRecorder(std::make_shared<RawlogRecorder>(path));
 }
 
-void registerRunInfoReader(const std::string& extension, RunInfoReader reader) {
-  auto& r = recorders();
-  std::lock_guard<std::mutex> l(r.m);
-  r.info_by_extension[extension] = std::move(reader);
-}
-
-void registerRecordedRobotReader(const std::string& extension, RunInfoReader reader) {
-  auto& r = recorders();
-  std::lock_guard<std::mutex> l(r.m);
-  r.robot_by_extension[extension] = std::move(reader);
-}
-
 Json readRecordedRobot(const std::string& path) {
-  RunInfoReader reader;
-  {
-    auto& r = recorders();
-    std::lock_guard<std::mutex> l(r.m);
-    const auto it = r.robot_by_extension.find(std::filesystem::path(path).extension().string());
-    if (it == r.robot_by_extension.end()) return Json::object();
-    reader = it->second;
-  }
-  return reader(path);
+  if (const auto f = formatOf(path); f && f->robot) return f->robot(path);
+  return Json::object();
 }
 
 Json readRunInfo(const std::string& path) {
-  const std::string ext = std::filesystem::path(path).extension().string();
-  {
-    auto& r = recorders();
-    std::lock_guard<std::mutex> l(r.m);
-    const auto it = r.info_by_extension.find(ext);
-    if (it != r.info_by_extension.end()) return it->second(path);
-  }
+  if (const auto f = formatOf(path)) return f->run_info ? f->run_info(path) : Json::object();
   const std::string p = path + ".run.json";
   if (!std::filesystem::exists(p)) return Json::object();
   Json j = parseJsonFile(p, "run info");

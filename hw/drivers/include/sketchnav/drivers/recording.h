@@ -39,9 +39,6 @@ class Recorder {
 /// bag's /sketchnav/run_info message); an empty object when there is none (an older recording,
 /// a bag from elsewhere). InputError naming the file when it is there but unreadable.
 Json readRunInfo(const std::string& path);
-using RunInfoReader = std::function<Json(const std::string& path)>;
-/// `extension` with its dot, e.g. ".bag"; thread-safe.
-void registerRunInfoReader(const std::string& extension, RunInfoReader reader);
 
 /// What a recording made elsewhere shows of the robot without run info, as setting keys: a ROS
 /// bag's tf gives the camera mount (robot.camera.*, from base_link to its images' optical
@@ -49,19 +46,27 @@ void registerRunInfoReader(const std::string& extension, RunInfoReader reader);
 /// rawlog; a bag without tf to its camera). A replay takes these for the keys neither the run
 /// info nor the user sets. Unlike run info, they do not change the replay's time origin.
 Json readRecordedRobot(const std::string& path);
-/// `extension` with its dot; thread-safe.
-void registerRecordedRobotReader(const std::string& extension, RunInfoReader reader);
+
+using RecorderFactory = std::function<std::shared_ptr<Recorder>(const std::string& path)>;
+using RecordingReader = std::function<Json(const std::string& path)>;
+/// A recording file format other than the built-in MRPT rawlog (".bag", registered by
+/// sketchnav::ros): how to write one and what to read back from one. An empty reader reads
+/// nothing (an empty object).
+struct RecordingFormat {
+  RecorderFactory open;      // openRecorder()
+  RecordingReader run_info;  // readRunInfo()
+  RecordingReader robot;     // readRecordedRobot()
+};
+/// `extension` with its dot, e.g. ".bag". Thread-safe; a later registration replaces one.
+void registerRecordingFormat(const std::string& extension, RecordingFormat format);
 
 /// A RawlogRecorder as a Recorder (labels CAMERA, ODOMETRY, LASER / SONAR, CMD_VEL / CMD_STOP).
 std::shared_ptr<Recorder> rawlogRecorder(std::shared_ptr<RawlogRecorder> rawlog);
 
-/// Opens a recording by the file name's extension: one registered with registerRecorder()
+/// Opens a recording by the file name's extension: one registered with registerRecordingFormat()
 /// (".bag" by sketchnav::ros), an MRPT rawlog otherwise. InputError for ".bag" in a build
 /// without ROS.
 std::shared_ptr<Recorder> openRecorder(const std::string& path);
-using RecorderFactory = std::function<std::shared_ptr<Recorder>(const std::string& path)>;
-/// `extension` with its dot, e.g. ".bag". Thread-safe; a later registration replaces one.
-void registerRecorder(const std::string& extension, RecorderFactory factory);
 
 std::unique_ptr<Camera> recordCamera(std::unique_ptr<Camera> inner,
                                      std::shared_ptr<Recorder> recorder);
