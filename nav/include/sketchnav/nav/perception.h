@@ -104,9 +104,9 @@ struct PerceptionParams {
   // centre: the object only when the photo shows it centred. false: the matched object's
   // offset from the image centre (x_d = 0; x_t is the centre of the matched part of the
   // database photo through the homography, the column the bearing is read at): more frames
-  // agree with the truth, but it is not the default yet (a closed-loop integration run and a
-  // replay's equality change with it). Evidence: doc/perception-benchmark.md "The servo
-  // error: the object's offset, not the photo's".
+  // of the real-photo benchmark agree with the truth, but the generated worlds' closed loop did
+  // not gain from it. Evidence: doc/perception-benchmark.md "The servo error: the object's
+  // offset, not the photo's".
   bool paper_offset = true;
   // The camera's pan and tilt, from the camera mount (the "robot.camera.*" settings,
   // CameraMount in core/camera_mount.h): not settings of their own.
