@@ -140,6 +140,7 @@ int main(int argc, char** argv) {
   nav::PerceptionParams off, on;
   off.camera_yaw = on.camera_yaw = world.camera.yaw;
   off.fovea = false;
+  on.fovea = true;  // the comparison is the look against none, whatever the default
   for (const auto& [k, v] : o.set) {
     Setter st{k, v};
     on.bind(st);

@@ -67,10 +67,11 @@ struct ExecutiveParams : DriveParams,
   // goal_settle_*). 0 = off.
   double section_settle_frac = 0.3;  // fraction of the section's length
   double section_settle_s = 15;      // [s]
-  // Where the sketch puts the attended landmarks goes to perception (a foveal look there) on
-  // every frame, not only in the final look (final_look_fovea): landmarks are then recognised about
-  // twice as far away (3 -> 5 m), and with far sightings kept as bearings (fit_bearing_only) their
-  // rays cross over a longer baseline, which places them without the laser's range.
+  // Where the sketch puts the attended landmarks goes to perception on every frame, not only in
+  // the final look (final_look_fovea), for its foveal second look there (nav.perception.fovea,
+  // off by default: it then costs nothing). With the model's own training photos as textures
+  // the look recognised landmarks about twice as far away (3 -> 5 m); on photos it was not
+  // trained on it rarely finds one (doc/landmark-model.md "Foveal second look").
   bool fovea_hints = true;
   template <class B>
   void bind(B& b) {

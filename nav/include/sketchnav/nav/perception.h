@@ -129,8 +129,11 @@ struct PerceptionParams {
   // vertically, fovea_height of the frame tall, taller for a landmark nearer than
   // 2 x fovea_ref_range_m (frame height / upscale), which may be seen well above or below the
   // centre. doc/landmark-model.md "Foveal second look"; the evidence for the defaults:
-  // doc/perception-benchmark.md "Evidence for the foveal second-look defaults".
-  bool fovea = true;               // take the second look at all
+  // doc/perception-benchmark.md "Evidence for the foveal second-look defaults". Off by default:
+  // on photos the model was not trained on, upscaling a distant landmark's crop adds pixels but
+  // not the detail the matcher needs, so the look rarely finds one and costs a fifth of the
+  // perception time per frame.
+  bool fovea = false;              // take the second look at all
   double fovea_min_range_m = 0;    // [m] no second look at landmarks predicted nearer
   double fovea_max_range_m = 6;    // [m] nor further (too few pixels even upscaled)
   double fovea_width = 0.4;        // crop width, fraction of the frame width, (0, 1]
