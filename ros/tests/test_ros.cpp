@@ -1338,10 +1338,13 @@ TEST_F(RosTest, PythonActionClientDrivesAndCancelsARoute) {
   EXPECT_EQ(c["state"], "PREEMPTED");
   EXPECT_EQ(c["failure"], "cancelled");
   EXPECT_TRUE(c["cancelled_by_client"].get<bool>());
+  // The second route starts where the first ended, often with its first landmark behind: it
+  // may begin by turning on the spot to look for it (v = 0) for longer than the 8 s before the
+  // cancel on a loaded machine. Turning on the spot is driving the route too.
   bool moved = false;
   for (const auto& m : commands())
-    if (m.wall > sent && std::abs(m.v) > 0.05) moved = true;
-  EXPECT_TRUE(moved) << "the robot never drove the second route" << logs();
+    if (m.wall > sent && (std::abs(m.v) > 0.05 || std::abs(m.w) > 0.05)) moved = true;
+  EXPECT_TRUE(moved) << "the robot never moved for the second route" << logs();
   std::this_thread::sleep_for(std::chrono::milliseconds(500));
   const auto cmds = commands();
   ASSERT_FALSE(cmds.empty());
