@@ -106,7 +106,8 @@ struct SideLookParams {
   // once the line of sight to it has turned side_look_rebearing_deg [deg] (odometry frame, so
   // turning on the spot does not count) since the last one started: a poster on a side wall is
   // seen at a grazing angle from afar and nearly face-on when the robot is abreast of it.
-  int side_look_max_looks = 1;
+  // Evidence for the default: doc/experiments.md "Three side looks, the foveal look off".
+  int side_look_max_looks = 3;
   double side_look_rebearing_deg = 25;
   // A look stands the robot still for up to side_look_s: none starts, and one under way gives
   // way, while a walking person (MoverTracker::walkers) is within side_look_walker_m [m] or the
