@@ -157,8 +157,10 @@ TEST(SideLook, FurtherLooksOnlyFromANewViewpoint) {
   const AttendedLandmark behind{0, 0, {-150 * kDeg, 2.5}, true};  // beyond 110 anyway
   EXPECT_FALSE(look.update(lt, &a105, 30.0, true, false, false, false, 40 * kDeg).started);
   EXPECT_FALSE(look.update(lt, &behind, 31.0, true, false, false, false, 0.0).started);
-  // With the default of one look, the second viewpoint gets none.
-  SideLook once(SideLookParams{}, 30 * kDeg, 1.2, 0.8);
+  // With one look per landmark (the default until 2026-12-07), the second viewpoint gets none.
+  SideLookParams one;
+  one.side_look_max_looks = 1;
+  SideLook once(one, 30 * kDeg, 1.2, 0.8);
   ASSERT_TRUE(once.update(lt, &a35, 10.0, true, false, false, false, 0.0).started);
   ASSERT_TRUE(once.update(lt, &a35, 14.1, true, false, false, false, 0.0).ended);
   EXPECT_FALSE(once.update(lt, &a90, 20.0, true, false, false, false, 0.0).started);
