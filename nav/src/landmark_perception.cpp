@@ -382,7 +382,7 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
   for (const auto& w : windows) ob.windows.push_back(w.box);
 
   t = clk::now();
-  const landmarks::MatchParams mp = P.match;
+  const landmarks::MatchParams& mp = P.match;
   std::vector<cv::Rect> boxes;
   for (const auto& w : windows) boxes.push_back(w.box);
   if (P.whole_frame) boxes.push_back(cv::Rect());  // empty = the whole frame
@@ -426,7 +426,7 @@ void LandmarkPerception::foveaPass(const hw::Frame& frame, const hw::Intrinsics&
 
   const auto tf = clk::now();
   const cv::Mat& img = frame.image;
-  const landmarks::MatchParams mp = P.match;
+  const landmarks::MatchParams& mp = P.match;
   std::vector<std::string> looked;  // one second look per class
   for (const auto& l : look_for) {
     if (!std::isfinite(l.bearing) || model.classId(l.class_name) < 0) continue;
