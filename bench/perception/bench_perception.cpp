@@ -5,7 +5,10 @@
 // landmark's class with a hint: its true bearing and range, perturbed by `--hint-bearing`
 // degrees and `--hint-range` (relative). Prints, per setting and distance, how many landmarks
 // were recognised, the time per frame, and false detections when another landmark's class is
-// hinted at it. Not a timed test: run by hand, e.g.
+// hinted at it. `--world` takes another world's landmarks and textures; `--set` changes the
+// "on" side's settings, `--base-set` the "off" side's (so two settings can be compared with the
+// fovea off on both: `--set fovea=false --set frame_max_side=640`). Not a timed test: run by
+// hand, e.g.
 //   bench_perception --angle 0,40 --dist 2,3,4,5,6
 #include <opencv2/core/utility.hpp>
 #include <opencv2/imgcodecs.hpp>
@@ -46,6 +49,8 @@ struct Options {
   std::string model;                                     // .slm (default: trained/cached)
   std::string frames_dir;                                // save rendered frames here
   std::vector<std::pair<std::string, std::string>> set;  // nav.perception overrides (fovea on)
+  std::vector<std::pair<std::string, std::string>> base_set;  // ... of the baseline (fovea off)
+  std::string world = "lab";  // a name in share/worlds or a .world.json file
   bool verbose = false;
 };
 
@@ -89,20 +94,22 @@ Options parse(int argc, char** argv) {
       o.model = next();
     else if (a == "--frames")
       o.frames_dir = next();
-    else if (a == "--set") {
+    else if (a == "--world")
+      o.world = next();
+    else if (a == "--set" || a == "--base-set") {
       const std::string kv = next();
       const auto eq = kv.find('=');
       if (eq == std::string::npos) {
-        std::cerr << "--set expects name=value\n";
+        std::cerr << a << " expects name=value\n";
         std::exit(2);
       }
-      o.set.emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
+      (a == "--set" ? o.set : o.base_set).emplace_back(kv.substr(0, eq), kv.substr(eq + 1));
     } else if (a == "-v")
       o.verbose = true;
     else {
       std::cerr << "usage: bench_perception [--angle 0,40] [--dist 1,2,...] [--turn DEG]\n"
                    "  [--hint-bearing DEG] [--hint-range REL] [--model FILE.slm] [--frames DIR] "
-                   "[--set fovea_x=V]... [-v]\n";
+                   "[--set fovea_x=V]... [--base-set x=V]... [--world NAME|FILE] [-v]\n";
       std::exit(a == "--help" ? 0 : 2);
     }
   }
@@ -134,22 +141,24 @@ int main(int argc, char** argv) {
   }
   model->buildIndexes();
 
-  sim::Simulator simr(sim::labWorld());
+  sim::Simulator simr(sim::loadWorldByName(o.world));
   const auto& world = simr.world();
   const hw::Intrinsics K = world.camera.intrinsics();
   nav::PerceptionParams off, on;
   off.camera_yaw = on.camera_yaw = world.camera.yaw;
   off.fovea = false;
   on.fovea = true;  // the comparison is the look against none, whatever the default
-  for (const auto& [k, v] : o.set) {
-    Setter st{k, v};
-    on.bind(st);
-    if (!st.done) {
-      std::cerr << "--set: no nav.perception field '" << k << "'\n";
-      return 2;
+  for (const auto* sets : {&o.set, &o.base_set})
+    for (const auto& [k, v] : *sets) {
+      Setter st{k, v};
+      (sets == &o.set ? on : off).bind(st);
+      if (!st.done) {
+        std::cerr << "--set: no nav.perception field '" << k << "'\n";
+        return 2;
+      }
     }
-  }
   on.validate();
+  off.validate();
   nav::LandmarkPerception p_off(model, off), p_on(model, on);
   if (!o.frames_dir.empty()) std::filesystem::create_directories(o.frames_dir);
 
