@@ -311,9 +311,50 @@ struct Executive::Impl {
     reportMiss(landmarks.miss(sec, i, counts));
   }
 
+  // What one control tick carries from one stage to the next (tick()).
+  struct Tick {
+    hw::Frame frame;
+    bool have_frame = false;  // a new camera frame this tick
+    bool perceived = false;   // perception looked at `frame` this tick
+    int k = -1;               // the current section
+    const mapsketch::PathSection* sec = nullptr;
+    SectionProgress prog;
+    std::vector<AttendedLandmark> att;                // the attended landmarks, first served
+    const mapsketch::ExpectedLandmark* lm = nullptr;  // the first of them (null: none)
+    const LandmarkTrack* tr = nullptr;                // and its track
+    Polar pred;                                       // where the sketch puts it
+    double servo_error = std::numeric_limits<double>::quiet_NaN();
+    CommandArbiter arb;  // the behaviours' proposals
+    bool servoing = false;
+    bool docking = false;
+    bool dodging = false;              // an avoidance manoeuvre (reactive or planned) is under way
+    double front = 0;                  // [m] free length ahead (telemetry)
+    double target_bearing = 0;         // [rad] where following (or the servo, or docking) heads
+    DodgeSide side = DodgeSide::None;  // the avoidance's rotation direction
+    std::vector<Mover> walkers;        // the mover tracker's walkers
+    SideLook::Outcome sl;
+  };
+
+  // One control tick, in the order of doc/navigation.md: the sensors, the safety checks, the
+  // route's sections, the landmark stage, the behaviours' proposals, the ends of sections, and
+  // the command. A stage that ends the run (or has nothing left to do this tick) returns false.
   void tick() {
     now = dev.clock->now();
-    // --- sensors -----------------------------------------------------------------------
+    Tick t;
+    readSensors(t);
+    if (!checkSafety()) return;
+    if (!sectionStage(t)) return;
+    if (!landmarkStage(t)) return;
+    proposeDrive(t);
+    proposeAvoidance(t);
+    proposeSideLook(t);
+    if (!sectionEnds(t)) return;
+    command(t);
+  }
+
+  // Odometry, range scans (the movers, the grid, the goal doorway) and a camera frame when one
+  // is due.
+  void readSensors(Tick& t) {
     hw::Odometry o;
     if (dev.base->odometry(o) && o.stamp > odom_stamp) {
       odom_stamp = o.stamp;
@@ -349,9 +390,8 @@ struct Executive::Impl {
         snap_t = now;
       }
     }
-    hw::Frame frame;
-    bool have_frame = false;
-    bool perceived = false;  // perception looked at `frame` this tick
+    hw::Frame& frame = t.frame;
+    bool& have_frame = t.have_frame;
     if (dev.camera && now + 1e-9 >= frame_stamp + s.exec.camera_period_s - 0.5 * s.exec.tick_s) {
       const auto st = dev.camera->grab(frame, 0.5 * s.exec.tick_s);
       if (st == hw::GrabStatus::Ok && frame.stamp > frame_stamp && !frame.image.empty()) {
@@ -366,7 +406,10 @@ struct Executive::Impl {
         grab_lag_ms = (now - frame.stamp) * 1e3;
       }
     }
-    // --- safety ------------------------------------------------------------------------
+  }
+
+  // The safety supervisor and the run's time limit; false: the run has ended.
+  bool checkSafety() {
     const auto st = safety.check(now, dev.base->ok());
     if (!st.ok()) {
       dev.base->stop();
@@ -379,14 +422,18 @@ struct Executive::Impl {
       }
       event(event::Fault{toString(st.fault), reason});
       fail(FailureCode::SafetyStop, "safety stop: " + reason);
-      return;
+      return false;
     }
     if (now - t0 > s.exec.max_time_s) {
       fail(FailureCode::Timeout, "timeout: route not completed in " +
                                      std::to_string(static_cast<int>(s.exec.max_time_s)) + " s");
-      return;
+      return false;
     }
-    // --- sections ----------------------------------------------------------------------
+    return true;
+  }
+
+  // Section bookkeeping: holds, arrival, the section's time budget; false: the run has ended.
+  bool sectionStage(Tick& t) {
     const int before = tracker.current();
     // A landmark of this section being servoed on says more about where the section ends than
     // odometry does: hold the section open until it is passed (or lost, or far overshot).
@@ -412,15 +459,15 @@ struct Executive::Impl {
             (t.state == LandmarkState::Pending && t.frames_seen > 0))
           passLandmark(kl, static_cast<int>(i), false);
       }
-      if (status != RunStatus::Running) return;
+      if (status != RunStatus::Running) return false;
       if (!final_looking) final_looking = finalLook();
     }
     hold |= final_looking;
     if (!hold && tracker.update(pose) > 0) closeSections(before);
-    if (status != RunStatus::Running) return;
+    if (status != RunStatus::Running) return false;
     if (tracker.finished()) {
       succeed("reached the end of the route");
-      return;
+      return false;
     }
     const auto& sec = tracker.section();
     const int k = tracker.current();
@@ -430,18 +477,30 @@ struct Executive::Impl {
       fail(FailureCode::NoProgress, "section " + std::to_string(k + 1) + "/" +
                                         std::to_string(tracker.count()) + ": no progress after " +
                                         std::to_string(static_cast<int>(budget)) + " s");
-      return;
+      return false;
     }
     const auto prog = tracker.progress(pose);
+    t.k = k;
+    t.sec = &sec;
+    t.prog = prog;
+    return true;
+  }
 
-    // --- landmark stage ------------------------------------------------------------------
+  // The attended landmarks, perception on the frame, association, the servo law, passes and
+  // misses; false: the run has ended.
+  bool landmarkStage(Tick& t) {
+    const int k = t.k;
+    const SectionProgress& prog = t.prog;
+    const hw::Frame& frame = t.frame;
+    const bool have_frame = t.have_frame;
+    bool& perceived = t.perceived;
     // Attended landmarks: the first one of this section not yet passed or missed (or else the
     // first of the next section: a landmark just past a guide point is often in view before
     // that section starts), and the one after it. The robot servos on the first only; the
     // second is looked for in the same frames because it often comes into view while the
     // first is still expected (two landmarks a few metres apart on opposite sides of the path)
     // and is too close to be recognised by the time the first is passed.
-    std::vector<AttendedLandmark> att;
+    std::vector<AttendedLandmark>& att = t.att;
     if (final_looking) {
       const auto [fk, fi] = final_look.target();
       const auto& l = landmarks.landmark(fk, fi);
@@ -465,7 +524,7 @@ struct Executive::Impl {
             passLandmark(kk, static_cast<int>(i), false);
           else
             markMissed(kk, static_cast<int>(i));
-          if (status != RunStatus::Running) return;
+          if (status != RunStatus::Running) return false;
           continue;
         }
         const auto& l = ss.landmarks[i];
@@ -479,7 +538,6 @@ struct Executive::Impl {
     const mapsketch::ExpectedLandmark* lm =
         att.empty() ? nullptr : &landmarks.landmark(att[0].k, att[0].i);
     const LandmarkTrack* tr = att.empty() ? nullptr : &landmarks.track(att[0].k, att[0].i);
-    double servo_error = std::numeric_limits<double>::quiet_NaN();
     const Polar pred = att.empty() ? Polar{} : att[0].pred;
     std::vector<std::string> classes;
     for (const auto& x : att) {
@@ -550,7 +608,7 @@ struct Executive::Impl {
       }
     }
     for (const auto& x : att) {
-      if (status != RunStatus::Running) return;
+      if (status != RunStatus::Running) return false;
       switch (landmarks.checkUnseen(x.k, x.i, now)) {
         case LandmarkTracker::Unseen::AtIt:  // slid out of the side of the image when close
           passLandmark(x.k, x.i, false);
@@ -562,15 +620,29 @@ struct Executive::Impl {
           break;
       }
     }
-    if (status != RunStatus::Running) return;
+    t.lm = lm;
+    t.tr = tr;
+    t.pred = pred;
+    return status == RunStatus::Running;
+  }
 
-    // --- command -------------------------------------------------------------------------
+  // Each behaviour that applies proposes a command (t.arb).
+  // Route following or the servo, and docking at the goal (t.arb); the target bearing and the
+  // side to dodge to for the stages after.
+  void proposeDrive(Tick& t) {
+    const int k = t.k;
+    const SectionProgress& prog = t.prog;
+    const std::vector<AttendedLandmark>& att = t.att;
+    const mapsketch::ExpectedLandmark* const lm = t.lm;
+    const LandmarkTrack* const tr = t.tr;
+    const Polar& pred = t.pred;
+    double& servo_error = t.servo_error;
     // Each behaviour that applies proposes a command; the arbiter's priority list decides
     // (command_arbiter.h). The proposals below come lowest priority first.
-    CommandArbiter arb;
-    double target_bearing;
-    const bool servoing =
-        tr && tr->state == LandmarkState::Tracking && now - servo_t <= s.exec.servo_hold_s;
+    CommandArbiter& arb = t.arb;
+    double& target_bearing = t.target_bearing;
+    t.servoing = tr && tr->state == LandmarkState::Tracking && now - servo_t <= s.exec.servo_hold_s;
+    const bool servoing = t.servoing;
     if (servoing) {
       target_bearing = servo_bearing;
       servo_error = servo_cmd.error;
@@ -590,7 +662,7 @@ struct Executive::Impl {
     const mapsketch::ExpectedLandmark* next_lm = lm;
     if (lm && att.size() > 1 && pred.range <= landmarks.passDistance(att[0].k, att[0].i) + 1.0)
       next_lm = &landmarks.landmark(att[1].k, att[1].i);
-    DodgeSide side = DodgeSide::None;
+    DodgeSide& side = t.side;
     if (next_lm) {
       if (next_lm->side == mapsketch::Side::Left) side = DodgeSide::Left;
       if (next_lm->side == mapsketch::Side::Right) side = DodgeSide::Right;
@@ -604,7 +676,7 @@ struct Executive::Impl {
     // the wall behind it; the speed is still capped by the clearance ahead.
     // Without a free straight line (a goal in a doorway: the line grazes the door frame), a
     // path planned on the grid leads there, or as near as the robot fits.
-    bool docking = false;
+    bool& docking = t.docking;
     if (k + 1 == tracker.count() && docker.near(prog.to_end_m) && !dev.ranges.empty()) {
       const Eigen::Vector2d goal = tracker.endOdom(k);
       const Polar pg = polarFrom(pose, goal);
@@ -631,7 +703,22 @@ struct Executive::Impl {
         arb.propose(Behaviour::Dock, d->command);
       }
     }
-    const std::vector<Mover> walkers = movers.walkers();  // for the avoider and the side look
+  }
+
+  // Walkers' lanes, recovery when stuck, the avoider and its detours (t.arb).
+  void proposeAvoidance(Tick& t) {
+    const int k = t.k;
+    const std::vector<AttendedLandmark>& att = t.att;
+    const mapsketch::ExpectedLandmark* const lm = t.lm;
+    const LandmarkTrack* const tr = t.tr;
+    CommandArbiter& arb = t.arb;
+    const double target_bearing = t.target_bearing;
+    const DodgeSide side = t.side;
+    const bool servoing = t.servoing, docking = t.docking;
+    double& front = t.front;
+    bool& dodging = t.dodging;
+    t.walkers = movers.walkers();  // for the avoider and the side look
+    const std::vector<Mover>& walkers = t.walkers;
     // A walker coming at the robot whose lane covers it: stepping out of the lane is the
     // dodge's, which a recovery would keep from running (a robot driving clear of a corner
     // drove into the lane of a person walking at it and stood there until they walked into it).
@@ -687,8 +774,6 @@ struct Executive::Impl {
         event(event::RecoverEnd{});
       }
     }
-    double front = 0;
-    bool dodging = false;  // an avoidance manoeuvre (reactive or planned) is under way
     if (docking || recovery.active()) {
       if (!dev.ranges.empty()) avoider.observe(scans, pose);
       endDetour(docking ? "docking" : "recovering");
@@ -743,6 +828,14 @@ struct Executive::Impl {
     } else {
       endDetour("no range data");
     }
+  }
+
+  // Looking to the side for a landmark predicted out of view (t.arb, t.sl).
+  void proposeSideLook(Tick& t) {
+    const std::vector<AttendedLandmark>& att = t.att;
+    CommandArbiter& arb = t.arb;
+    const bool docking = t.docking, dodging = t.dodging;
+    const std::vector<Mover>& walkers = t.walkers;
     // Looking to the side for a landmark predicted out of view (SideLook). A look stands the
     // robot still: none starts, and one under way gives way, near a walking person
     // (side_look_walker_m) or in their lane.
@@ -750,16 +843,25 @@ struct Executive::Impl {
     for (const auto& m : walkers)
       walker_near |=
           (m.position - Eigen::Vector2d(pose.x, pose.y)).norm() <= s.exec.side_look_walker_m;
-    const auto sl =
-        side_look.update(landmarks, att.empty() ? nullptr : &att[0], now, dev.camera != nullptr,
-                         docking || recovery.active() || walker_near, final_looking,
-                         (dodging && detour.movingSeen()) || walker_near, pose.theta);
+    t.sl = side_look.update(landmarks, att.empty() ? nullptr : &att[0], now, dev.camera != nullptr,
+                            docking || recovery.active() || walker_near, final_looking,
+                            (dodging && detour.movingSeen()) || walker_near, pose.theta);
+    const auto& sl = t.sl;
     if (sl.ended) {
       event(*sl.ended);
       progress_checker.reset(pose, now);  // standing still to look is not being stuck
     }
     if (sl.started) event(*sl.started);
     if (sl.command) arb.propose(Behaviour::SideLook, *sl.command);
+  }
+
+  // Ends that cannot be reached, a settled goal or section; false: the run has ended.
+  bool sectionEnds(Tick& t) {
+    const int k = t.k;
+    const mapsketch::PathSection& sec = *t.sec;
+    const SectionProgress& prog = t.prog;
+    const bool servoing = t.servoing, dodging = t.dodging;
+    const SideLook::Outcome& sl = t.sl;
     // An end point that cannot be reached (the sketch put it in or against an obstacle): when
     // the robot is dodging within end_blocked_m of it, the section is done.
     bool end_blocked = false;
@@ -789,10 +891,10 @@ struct Executive::Impl {
       event(event::GoalSettled{prog.to_end_m});
       tracker.advance();
       closeSections(k);
-      if (status != RunStatus::Running) return;
+      if (status != RunStatus::Running) return false;
       succeed("reached the end of the route (could not get closer than " +
               std::to_string(prog.to_end_m).substr(0, 4) + " m)");
-      return;
+      return false;
     }
     // An intermediate end the robot cannot get near, blocked or not in view (the corner drawn
     // beyond the corridor's wall): the section is done where the robot came closest.
@@ -804,20 +906,31 @@ struct Executive::Impl {
       event(event::SectionSettled{k, prog.to_end_m});
       tracker.advance();
       closeSections(k);
-      if (status != RunStatus::Running) return;
+      if (status != RunStatus::Running) return false;
     }
     if (end_blocked) {
       sectionBlocked_ = true;
       event(event::EndBlocked{k, prog.to_end_m});
       tracker.advance();
       closeSections(k);
-      if (status != RunStatus::Running) return;
+      if (status != RunStatus::Running) return false;
       if (tracker.finished()) {
         succeed("reached the end of the route (end point blocked, " +
                 std::to_string(prog.to_end_m).substr(0, 4) + " m away)");
-        return;
+        return false;
       }
     }
+    return true;
+  }
+
+  // Walking people, the final look and the following gap have the last word; the command is
+  // sent and the tick's telemetry row written.
+  void command(Tick& t) {
+    const int k = t.k;
+    const mapsketch::ExpectedLandmark* const lm = t.lm;
+    CommandArbiter& arb = t.arb;
+    const bool perceived = t.perceived;
+    const double servo_error = t.servo_error, front = t.front;
     // Walking people: keep out of their lanes (movers.h). In one: step out sideways (backing
     // only slowly and with room behind); about to enter one: wait, turning is harmless. With
     // lane keeping off, still the waiting, for walkers only (the tracker's walkers, not every
