@@ -200,7 +200,8 @@ void ObstacleAvoider::observe(const std::vector<hw::RangeScan>& scans, const hw:
 
 void ObstacleAvoider::rememberScans(const std::vector<hw::RangeScan>& scans) {
   const auto& P = params_;
-  if (!have_pose_ || P.rear_memory_s <= 0 || P.lane_reverse_speed <= 0) return;
+  if (!have_pose_ || P.rear_memory_s <= 0 || (P.lane_reverse_speed <= 0 && !P.unseen_not_open))
+    return;
   double stamp = -1;
   for (const auto& sc : scans) stamp = std::max(stamp, sc.stamp);
   if (stamp <= seen_stamp_ + 1e-9) return;  // nothing new since the last
@@ -219,10 +220,10 @@ void ObstacleAvoider::rememberScans(const std::vector<hw::RangeScan>& scans) {
     seen.pop_front();
 }
 
-bool ObstacleAvoider::sweptSeenFree(double direction, double len) const {
+bool ObstacleAvoider::sweptSeenFree(double direction, double len, double half_width) const {
   const auto& seen = impl_->seen;
   if (seen.empty() || !have_pose_) return false;
-  const double R = params_.robot_radius_m + 0.02;
+  const double R = half_width > 0 ? half_width : params_.robot_radius_m + 0.02;
   const double c = std::cos(pose_.theta), sn = std::sin(pose_.theta);
   const double dc = std::cos(direction), ds = std::sin(direction);
   // Samples over the swept disc: its centre line and both edges every 0.1 m, and the far end's
@@ -737,7 +738,26 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   // route direction; otherwise the first open direction is searched from the route direction
   // towards the chosen side (then the other side): a stable tangent around the obstacle.
   const double open_m = P.trigger_m;
-  auto open = [&](double a) { return corridorFree(pts, a, hw, P.max_range_m) >= open_m; };
+  // A direction outside every range sensor's view now is open only where a scan of the last
+  // rear_memory_s saw its floor free. Taken for open because nothing was seen there, a gap just
+  // beyond the laser's edge drew a robot turning on the spot towards it, was seen closed once
+  // the robot faced it, and the robot turned back to the other gap, which left its view in
+  // turn: it swung left and right for seconds (generated mixed-8, 34 alternating ticks).
+  // In view: the band the robot would sweep, out to open_m, lies inside a sensor's span.
+  const double band = std::atan2(hw, open_m);
+  auto in_view = [&](double a) {
+    for (const auto& sc : scans) {
+      if (sc.angles.empty()) continue;
+      const auto [lo, hi] = std::minmax_element(sc.angles.begin(), sc.angles.end());
+      const double half_beam = 0.5 * sc.beam_width;
+      if (a - band >= *lo - half_beam && a + band <= *hi + half_beam) return true;
+    }
+    return false;
+  };
+  auto open = [&](double a) {
+    return corridorFree(pts, a, hw, P.max_range_m) >= open_m &&
+           (!P.unseen_not_open || in_view(a) || sweptSeenFree(a, open_m, hw));
+  };
   // On the chosen side of the route direction, or not more than 0.35 rad the other way.
   // Against someone coming towards the robot, a direction close to the route's runs along
   // their lane: at least half the side bias out of it (an exp4-pedestrian-left robot drifted
@@ -776,9 +796,16 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   bool found = nd_ok;
   // Hysteresis: a direction chosen before (kept in the odometry frame) that is still open is
   // kept, so the robot does not swing between two gaps while the target bearing moves.
+  // With unseen_not_open, a direction kept is given up only when the current scan shows it
+  // closing (less than half of open_m free): chosen as open, it is not dropped for leaving the
+  // sensors' view as the robot turns on the spot, nor for a reading that sits at the threshold,
+  // so the robot does not reverse its turn from one scan to the next.
+  auto still_open = [&](double a) {
+    return P.unseen_not_open ? corridorFree(pts, a, hw, P.max_range_m) >= 0.5 * open_m : open(a);
+  };
   if (!found && have_prev_) {
     const double a = wrapAngle(prev_dir_odom_ - heading);
-    if (std::abs(a) <= 2.2 && open(a) && (moving <= 0 || sided(a)) && allowed(a)) {
+    if (std::abs(a) <= 2.2 && still_open(a) && (moving <= 0 || sided(a)) && allowed(a)) {
       dir = a;
       found = true;
     }

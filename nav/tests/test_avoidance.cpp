@@ -644,3 +644,67 @@ TEST(AvoidParams, ValidateNamesTheField) {
   p.release_m = 0.1;
   EXPECT_THROW(p.validate(), InputError);
 }
+
+namespace {
+// test::scanAt's laser narrowed to +-60 degrees: most of the robot's surroundings unseen.
+hw::RangeScan narrowScanAt(const hw::Pose2D& pose, const std::vector<test::Box>& boxes,
+                           double stamp) {
+  hw::RangeScan full = test::scanAt(pose, boxes, {}, stamp), s = full;
+  s.angles.clear();
+  s.ranges.clear();
+  for (size_t i = 0; i < full.angles.size(); ++i)
+    if (std::abs(full.angles[i]) <= 60 * M_PI / 180 + 1e-6) {
+      s.angles.push_back(full.angles[i]);
+      s.ranges.push_back(full.ranges[i]);
+    }
+  return s;
+}
+}  // namespace
+
+TEST(Avoider, AWayOutNoScanHasSeenIsNotTakenForOpen) {
+  // A wall 0.6 m ahead across the whole of a +-60 degree laser's view; to the left, beyond
+  // the view, the floor is free. Nothing seen there reads as free, and without
+  // unseen_not_open the dodge heads for it; with it, the robot only turns towards its side
+  // (the boxed-in turn of 1.2 rad) until it has seen that floor.
+  const std::vector<test::Box> wall{{0.7, 0.0, 0.1, 3.0}};
+  const hw::Pose2D pose{0, 0, 0};
+  auto first = [&](bool unseen_not_open) {
+    AvoidParams p;
+    p.unseen_not_open = unseen_not_open;
+    ObstacleAvoider a(p);
+    a.setPose(pose);
+    return a.step({narrowScanAt(pose, wall, 0.0)}, 0.0, DodgeSide::Left, 0.0, 0.3, 0.0);
+  };
+  const auto off = first(false), on = first(true);
+  ASSERT_TRUE(off.active);
+  ASSERT_TRUE(on.active);
+  EXPECT_GT(off.direction, 1.25);  // a direction nothing was seen along
+  EXPECT_NEAR(on.direction, 1.2, 1e-9);
+  EXPECT_EQ(on.v, 0.0);
+
+  // Having looked left (heading +90 degrees: the laser saw that floor free), it is open, and
+  // as the robot turns towards it the direction is kept, not swapped for another each scan.
+  AvoidParams p;
+  p.unseen_not_open = true;
+  ObstacleAvoider a(p);
+  hw::Pose2D look{0, 0, M_PI / 2};
+  a.setPose(look);
+  a.step({narrowScanAt(look, wall, 0.0)}, -M_PI / 2, DodgeSide::Left, look.theta, 0.3, 0.0);
+  hw::Pose2D at{0, 0, 0};
+  double kept_odom = 0;
+  for (int k = 0; k < 8; ++k) {
+    const double t = 0.1 * (k + 1);
+    a.setPose(at);
+    const auto out =
+        a.step({narrowScanAt(at, wall, t)}, -at.theta, DodgeSide::Left, at.theta, 0.3, t);
+    ASSERT_TRUE(out.active) << k;
+    if (k == 0) {
+      EXPECT_GT(out.direction, 1.25);  // the floor seen free on the left
+      kept_odom = at.theta + out.direction;
+    } else {
+      EXPECT_NEAR(at.theta + out.direction, kept_odom, 1e-6) << k;  // the same way, turning on
+    }
+    EXPECT_GT(out.w, 0.0) << k;
+    at.theta += 0.08;  // 0.8 rad/s for 0.1 s
+  }
+}

@@ -79,7 +79,14 @@ struct AvoidParams {
   // since counts). lane_reverse_speed 0 = only forward ways out.
   double lane_reverse_speed = 0.25;  // [m/s]
   double rear_memory_s = 10.0;       // [s] laser scans kept to judge the floor behind
-  int sectors = 144;                 // polar diagram resolution over 360 deg
+  // A dodge direction outside every range sensor's view now counts as open only where a laser
+  // scan of the last rear_memory_s saw its floor free (sweptSeenFree), and a direction once
+  // chosen is kept until the current scan shows less than half of trigger_m free along it (a
+  // turn on the spot is not reversed from one scan to the next). false = nothing seen there
+  // counts as open, and the kept direction needs the full trigger_m. Evidence for the default:
+  // doc/navigation.md "Evidence for the defaults".
+  bool unseen_not_open = false;
+  int sectors = 144;  // polar diagram resolution over 360 deg
   template <class B>
   void bind(B& b) {
     b("robot_radius_m", robot_radius_m);
@@ -107,6 +114,7 @@ struct AvoidParams {
     b("lane_trail_s", lane_trail_s);
     b("lane_reverse_speed", lane_reverse_speed);
     b("rear_memory_s", rear_memory_s);
+    b("unseen_not_open", unseen_not_open);
     b("sectors", sectors);
   }
   void validate() const;  // InputError "nav.avoid.<field> = ...: ..."
@@ -178,11 +186,12 @@ class ObstacleAvoider {
   /// the pose and the laser scans, so that sweptSeenFree() judges from where the robot is
   /// and with what it saw meanwhile (a recovery that turned to look at its back).
   void observe(const std::vector<hw::RangeScan>& scans, const hw::Pose2D& pose);
-  /// Whether every part of the robot's disc swept `len` metres from its pose along `direction`
-  /// [rad, robot frame] lies on floor the newest remembered laser scan covering it saw free
-  /// (the current scan included; rear_memory_s). Unknown floor is not free. The pose and scans
-  /// are those of the last step().
-  bool sweptSeenFree(double direction, double len) const;
+  /// Whether every part of the band `half_width` [m] to each side (default: the robot's radius
+  /// + 2 cm, its disc) swept `len` metres from the robot's pose along `direction` [rad, robot
+  /// frame] lies on floor the newest remembered laser scan covering it saw free (the current
+  /// scan included; rear_memory_s). Unknown floor is not free. The pose and scans are those of
+  /// the last step().
+  bool sweptSeenFree(double direction, double len, double half_width = 0) const;
   /// Whether a point (odometry frame) lies where the floor was seen free a few seconds ago
   /// (the occupancy grid's memory, movers.h). Set, the point followed for the approach
   /// estimate counts as coming towards the robot only there: the nearest point of a wall or a
