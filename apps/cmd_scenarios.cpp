@@ -46,10 +46,15 @@ double boxDistance(const sim::Obstacle& o, const V2& p) {
 }
 
 // From a run's telemetry (true poses over time): the closest the robot's body came to a
-// person and to a piece of furniture, and the share of ticks in each executive mode.
+// person and to a piece of furniture, the share of ticks in each executive mode, and how often
+// the robot reversed a turn on the spot.
 struct Telemetry {
   double people_m = NAN, obstacles_m = NAN;
   std::map<std::string, double> mode_share;
+  // Ticks whose yaw-rate command (|w| > 0.3 rad/s) has the opposite sign of the previous such
+  // command of the same stand (|v| <= 0.05 m/s throughout): a robot swinging left and right on
+  // the spot instead of turning one way (doc/experiments.md "Dodge directions seen, not guessed").
+  int turn_reversals = 0;
 };
 
 Telemetry readTelemetry(const std::string& dir, const sim::World& w) {
@@ -59,6 +64,7 @@ Telemetry readTelemetry(const std::string& dir, const sim::World& w) {
   if (!std::getline(in, line)) return t;
   std::map<std::string, int> modes;
   int rows = 0;
+  int last_turn = 0;  // sign of the last turn on the spot
   double people = INFINITY, obst = INFINITY;
   while (std::getline(in, line)) {
     std::vector<std::string> f;
@@ -74,6 +80,14 @@ Telemetry readTelemetry(const std::string& dir, const sim::World& w) {
     for (const auto& o : w.obstacles) obst = std::min(obst, boxDistance(o, p) - w.robot.radius);
     ++modes[f[10]];
     ++rows;
+    const double v = std::stod(f[7]), wz = std::stod(f[8]);
+    if (std::abs(v) > 0.05) {
+      last_turn = 0;  // driving: a new stand starts afresh
+    } else if (std::abs(wz) > 0.3) {
+      const int sign = wz > 0 ? 1 : -1;
+      t.turn_reversals += last_turn == -sign;
+      last_turn = sign;
+    }
   }
   if (std::isfinite(people)) t.people_m = people;
   if (std::isfinite(obst)) t.obstacles_m = obst;
@@ -100,7 +114,7 @@ Json numOrNull(double x) {
 }
 
 struct Agg {
-  int n = 0, ok = 0, allowed = 0, allowed_ok = 0, collisions = 0, exec_ok = 0;
+  int n = 0, ok = 0, allowed = 0, allowed_ok = 0, collisions = 0, exec_ok = 0, reversals = 0;
   double goal_err_sum = 0, time_ok_sum = 0;
   double people_min = INFINITY, obst_min = INFINITY;
   void add(const Json& r) {
@@ -109,6 +123,7 @@ struct Agg {
     ok += s;
     exec_ok += r.value("executive_success", false);
     collisions += r.value("collided", false);
+    reversals += r.value("turn_reversals", 0);
     if (r["sketch_allows_success"].is_boolean() && r["sketch_allows_success"].get<bool>()) {
       ++allowed;
       allowed_ok += s;
@@ -130,6 +145,7 @@ struct Agg {
             {"success_rate_where_sketch_allows",
              allowed ? Json(static_cast<double>(allowed_ok) / allowed) : Json(nullptr)},
             {"collisions", collisions},
+            {"turn_reversals", reversals},
             {"mean_goal_error_m", n ? Json(goal_err_sum / n) : Json(nullptr)},
             {"mean_time_s_of_successes", ok ? Json(time_ok_sum / ok) : Json(nullptr)},
             {"min_clearance_people_m", numOrNull(people_min)},
@@ -311,6 +327,7 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
                                                                     : numOrNull(t.people_m);
     r["clearance_obstacles_m"] = numOrNull(t.obstacles_m);
     r["mode_share"] = t.mode_share;
+    r["turn_reversals"] = t.turn_reversals;
     r["events"] = eventCounts(dir);
     const Json diag = sm.value("diagnostics", Json::object());
     r["sketch_goal_error_m"] = diag.contains("sketch_goal_error_m")

@@ -62,6 +62,37 @@ if(NOT EXISTS ${WORK}/run/benchmark.md OR NOT EXISTS ${WORK}/run/benchmark.json)
   message(FATAL_ERROR "no benchmark report")
 endif()
 
+# Turns reversed on the spot: counted from the telemetry, per run and in all. A telemetry
+# written by hand (and the report made again from the kept runs): standing, left, right, left
+# (2), driving (a new stand), right, a slow left that does not count, left (1): 3.
+string(JSON name0 GET "${out}" runs 0 name)
+string(JSON name1 GET "${out}" runs 1 name)
+file(STRINGS ${WORK}/run/runs/${name0}/telemetry.csv tel LIMIT_COUNT 1)
+set(rows "${tel}\n")
+set(k 0)
+foreach(vw "0 0.8" "0 -0.8" "0.02 0.8" "0.3 0" "0 -0.8" "0 0.1" "0 0.8")
+  separate_arguments(vw)
+  list(GET vw 0 v)
+  list(GET vw 1 w)
+  math(EXPR k "${k} + 1")
+  string(APPEND rows "0.${k},0,0,0,1,1,0,${v},${w},,avoid,Straight,0,,1\n")
+endforeach()
+file(WRITE ${WORK}/run/runs/${name0}/telemetry.csv "${rows}")
+execute_process(COMMAND ${SN} --json scenarios --generate 2 --seed 7
+                        --families corridor,office --run --reuse --max-time 8 --jobs 2
+                        --out ${WORK}/run
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out2 ERROR_VARIABLE err)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "scenarios --run --reuse failed (${rc}):\n${out2}\n${err}")
+endif()
+string(JSON r0 GET "${out2}" runs 0 turn_reversals)
+string(JSON r1 GET "${out2}" runs 1 turn_reversals)
+string(JSON rall GET "${out2}" all turn_reversals)
+math(EXPR rsum "${r0} + ${r1}")
+if(NOT r0 EQUAL 3 OR NOT rall EQUAL rsum)
+  message(FATAL_ERROR "turn_reversals: ${name0} ${r0} (expected 3), ${name1} ${r1}, all ${rall}")
+endif()
+
 # Bad input: exit 2 with the field named.
 expect(2 "unknown family 'castle'" scenarios --generate 2 --families castle --out ${WORK}/e)
 expect(2 "--generate must be in" scenarios --generate 0 --out ${WORK}/e)
