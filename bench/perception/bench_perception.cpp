@@ -153,7 +153,8 @@ int main(int argc, char** argv) {
       Setter st{k, v};
       (sets == &o.set ? on : off).bind(st);
       if (!st.done) {
-        std::cerr << "--set: no nav.perception field '" << k << "'\n";
+        std::cerr << (sets == &o.set ? "--set" : "--base-set") << ": no nav.perception field '" << k
+                  << "'\n";
         return 2;
       }
     }

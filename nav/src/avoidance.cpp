@@ -744,14 +744,19 @@ AvoidOutput ObstacleAvoider::step(const std::vector<hw::RangeScan>& scans, doubl
   // the robot faced it, and the robot turned back to the other gap, which left its view in
   // turn: it swung left and right for seconds (generated mixed-8, 34 alternating ticks).
   // In view: the band the robot would sweep, out to open_m, lies inside a sensor's span.
+  // Each sensor's span (robot frame, sonar cones included), once per step: open() is asked
+  // for dozens of directions.
   const double band = std::atan2(hw, open_m);
-  auto in_view = [&](double a) {
+  std::vector<std::pair<double, double>> spans;
+  if (P.unseen_not_open)
     for (const auto& sc : scans) {
       if (sc.angles.empty()) continue;
       const auto [lo, hi] = std::minmax_element(sc.angles.begin(), sc.angles.end());
-      const double half_beam = 0.5 * sc.beam_width;
-      if (a - band >= *lo - half_beam && a + band <= *hi + half_beam) return true;
+      spans.emplace_back(*lo - 0.5 * sc.beam_width, *hi + 0.5 * sc.beam_width);
     }
+  auto in_view = [&](double a) {
+    for (const auto& [lo, hi] : spans)
+      if (a - band >= lo && a + band <= hi) return true;
     return false;
   };
   auto open = [&](double a) {

@@ -626,7 +626,6 @@ struct Executive::Impl {
     return status == RunStatus::Running;
   }
 
-  // Each behaviour that applies proposes a command (t.arb).
   // Route following or the servo, and docking at the goal (t.arb); the target bearing and the
   // side to dodge to for the stages after.
   void proposeDrive(Tick& t) {
