@@ -19,6 +19,7 @@
 #include "sketchnav/nav/executive.h"
 #include "sketchnav/run/judge.h"
 #include "sketchnav/run/run.h"
+#include "sketchnav/run/run_folder.h"
 #include "sketchnav/run/scenario.h"
 #include "sketchnav/run/scenario_gen.h"
 #include "sketchnav/sim/simulator.h"
@@ -59,32 +60,25 @@ struct Telemetry {
 
 Telemetry readTelemetry(const std::string& dir, const sim::World& w) {
   Telemetry t;
-  std::ifstream in(dir + "/telemetry.csv");
-  std::string line;
-  if (!std::getline(in, line)) return t;
   std::map<std::string, int> modes;
   int rows = 0;
   int last_turn = 0;  // sign of the last turn on the spot
   double people = INFINITY, obst = INFINITY;
-  while (std::getline(in, line)) {
-    std::vector<std::string> f;
-    std::stringstream ss(line);
-    for (std::string x; std::getline(ss, x, ',');) f.push_back(x);
-    if (f.size() < 11 || f[4].empty()) continue;
-    const double time = std::stod(f[0]);
-    const V2 p(std::stod(f[4]), std::stod(f[5]));
+  for (const run::TelemetryRecord& r : run::readTelemetryCsv(dir + "/telemetry.csv")) {
+    // A row without the true pose (no simulator) or cut before its mode (a killed run).
+    if (!r.truth || r.mode.empty()) continue;
+    const V2 p(r.truth->x, r.truth->y);
     for (const auto& ped : w.pedestrians) {
-      const auto st = sim::pedestrianAt(ped, time);
+      const auto st = sim::pedestrianAt(ped, r.t);
       people = std::min(people, (st.position - p).norm() - st.radius - w.robot.radius);
     }
     for (const auto& o : w.obstacles) obst = std::min(obst, boxDistance(o, p) - w.robot.radius);
-    ++modes[f[10]];
+    ++modes[r.mode];
     ++rows;
-    const double v = std::stod(f[7]), wz = std::stod(f[8]);
-    if (std::abs(v) > 0.05) {
+    if (std::abs(r.v_cmd) > 0.05) {
       last_turn = 0;  // driving: a new stand starts afresh
-    } else if (std::abs(wz) > 0.3) {
-      const int sign = wz > 0 ? 1 : -1;
+    } else if (std::abs(r.w_cmd) > 0.3) {
+      const int sign = r.w_cmd > 0 ? 1 : -1;
       t.turn_reversals += last_turn == -sign;
       last_turn = sign;
     }
