@@ -136,6 +136,7 @@ struct Simulator::Impl {
   double next_record = 0;
   SimStats stats;
   // Realtime pacing
+  static constexpr double kPacedMaxLag = 0.1;  // [s] backlog a paced run may catch up at once
   bool wall_started = false;
   std::chrono::steady_clock::time_point wall0;
   double sim0 = 0;
@@ -297,8 +298,18 @@ struct Simulator::Impl {
         wall0 = std::chrono::steady_clock::now();
         sim0 = t_state;
       }
-      std::this_thread::sleep_until(wall0 + std::chrono::duration_cast<std::chrono::nanoseconds>(
-                                                std::chrono::duration<double>(t_state - sim0)));
+      const auto due = wall0 + std::chrono::duration_cast<std::chrono::nanoseconds>(
+                                   std::chrono::duration<double>(t_state - sim0));
+      // Simulated time stands still while the loop computes (a long perception pass, the
+      // first one building the model's indexes), so a paced run falls behind the wall clock.
+      // It catches up by at most kPacedMaxLag: the rest of the backlog is dropped (the origin
+      // moves on) instead of being run at full speed, which would show the user a world
+      // faster than real time for as long as the stall lasted.
+      const auto late = std::chrono::steady_clock::now() - due;
+      const auto max_lag = std::chrono::duration_cast<std::chrono::steady_clock::duration>(
+          std::chrono::duration<double>(kPacedMaxLag));
+      if (late > max_lag) wall0 += late - max_lag;
+      std::this_thread::sleep_until(due);
     }
   }
   void sync() { advanceTo(clock->now()); }

@@ -11,10 +11,12 @@
 
 #include <sys/stat.h>
 
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <numeric>
+#include <thread>
 
 #include "sketchnav/core/error.h"
 #include "sketchnav/core/paths.h"
@@ -798,6 +800,24 @@ TEST(TimeModel, DevicesIntegrateLazilyToTheClock) {
   EXPECT_NEAR(x, 1.0 + 0.2 * 5.0 - ramp, 0.003);
   s.advanceTo(6.0);
   EXPECT_NEAR(s.clock()->now(), 6.0, 1e-12);
+}
+
+// A paced run (--realtime) whose loop stalled (simulated time stands still meanwhile) goes on
+// at the wall clock's pace: it used to run the whole backlog at full speed, a world faster
+// than real time for as long as the stall had lasted.
+TEST(TimeModel, APacedRunDoesNotRaceToCatchUpAfterAStall) {
+  sim::World w = boxWorld(20, 6);
+  sim::SimParams p = exactParams();
+  p.realtime = true;
+  sim::Simulator s(w, p);
+  s.advanceTo(0.1);                                             // the pacing's origin
+  std::this_thread::sleep_for(std::chrono::milliseconds(600));  // the loop computes
+  const auto t0 = std::chrono::steady_clock::now();
+  for (int k = 1; k <= 10; ++k) s.advanceTo(0.1 + 0.05 * k);  // ticks, as the loop's
+  const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+  // 0.5 s simulated, of which at most 0.1 s (the catch-up allowed) plus the first tick's
+  // 0.05 s without waiting; sleeps only ever last longer, so a slow machine cannot fail this.
+  EXPECT_GE(wall, 0.34);
 }
 
 // ---------------------------------------------------------------- registry and map
