@@ -184,7 +184,7 @@ cv::Mat thumbnail(const cv::Mat& img, const nav::Observation& ob, const Row& r,
 
 /// The benchmark's record of one frame (the sidecar, when there is one, gives u/yaw/width).
 bench::FrameScore score(const std::string& name, const std::string& expected, const Row& r,
-                        double x_t, const hw::Intrinsics& k,
+                        const nav::Observation& ob, double x_t, const hw::Intrinsics& k,
                         const std::optional<bench::SequenceTruth>& seq) {
   bench::FrameScore s;
   s.expected = expected;
@@ -192,6 +192,10 @@ bench::FrameScore score(const std::string& name, const std::string& expected, co
   s.found = r.turn != "None";
   s.u_found = std::isfinite(x_t) ? k.cx + x_t * k.fx : NAN;
   s.ms = r.ms;
+  s.full_pass = ob.timing.full_pass;
+  s.objectness_ms = ob.timing.objectness_ms, s.features_ms = ob.timing.features_ms;
+  s.match_ms = ob.timing.match_ms, s.recognise_ms = ob.timing.recognise_ms;
+  s.fovea_ms = ob.timing.fovea_ms;
   if (seq) {
     s.absent_sequence = seq->absent;
     if (auto it = seq->frames.find(name); it != seq->frames.end())
@@ -349,7 +353,8 @@ int runEval(const Args& args, GlobalOptions& g) {
 
   std::ofstream csv(out + "/eval.csv");
   csv << "sequence,frame,target,motion,absent,expected,turn,found,u_true,u_found,yaw_deg,"
-         "width_px,visible,inliers,ms\n";
+         "width_px,visible,inliers,ms,full_pass,objectness_ms,features_ms,match_ms,"
+         "recognise_ms\n";
   std::vector<bench::FrameScore> all;
   std::vector<std::vector<bench::FrameScore>> seq_scores(dirs.size());
   std::map<std::string, std::vector<bench::FrameScore>> by_motion;
@@ -369,7 +374,7 @@ int runEval(const Args& args, GlobalOptions& g) {
       ++i;
       const auto it = truths[s].find(name);
       if (it == truths[s].end()) continue;
-      const bench::FrameScore sc = score(name, it->second, r, x_t, k, seqs[s]);
+      const bench::FrameScore sc = score(name, it->second, r, fr.ob, x_t, k, seqs[s]);
       mine.push_back(sc);
       auto opt = [](double v) { return std::isfinite(v) ? std::to_string(v) : std::string(); };
       csv << dirs[s].filename().string() << ',' << name << ',' << seqs[s].target << ','
@@ -377,7 +382,8 @@ int runEval(const Args& args, GlobalOptions& g) {
           << (sc.expected.empty() ? "-" : sc.expected) << ',' << r.turn << ',' << sc.found << ','
           << opt(sc.truth.u) << ',' << opt(sc.u_found) << ',' << opt(sc.truth.yaw_deg) << ','
           << opt(sc.truth.width_px) << ',' << sc.truth.visible << ',' << r.inliers << ',' << r.ms
-          << '\n';
+          << ',' << sc.full_pass << ',' << sc.objectness_ms << ',' << sc.features_ms << ','
+          << sc.match_ms << ',' << sc.recognise_ms << '\n';
     }
     const Json sj = bench::summarise(mine);
     std::cerr << dirs[s].filename().string() << " (" << seqs[s].target
@@ -434,6 +440,17 @@ int runEval(const Args& args, GlobalOptions& g) {
     for (const auto& b : result["frame_budget"])
       std::printf(" %.0f ms met on %s", b["budget_ms"].get<double>(), pct(b["met_rate"]).c_str());
     std::cout << " of the frames\n";
+    const Json& fp = result["full_pass_ms"];
+    auto ms = [](const Json& v) {
+      return v.is_number() ? std::to_string(static_cast<int>(std::lround(v.get<double>())))
+                           : std::string("-");
+    };
+    std::cout << "full pass (" << fp["frames"] << " frames), median ms: total "
+              << ms(fp["total"]["median"]) << " = objectness " << ms(fp["objectness"]["median"])
+              << " + features " << ms(fp["features"]["median"]) << " + match "
+              << ms(fp["match"]["median"]) << " (recognition " << ms(fp["recognise"]["median"])
+              << "); tracked frames (" << fp["tracked_frames"] << ") "
+              << ms(fp["tracked_ms_median"]) << "\n";
     for (const char* key : {"by_yaw_deg", "by_width_px"})
       for (const auto& b : result[key])
         std::cout << "  " << key << " " << b["lo"] << "-" << b["hi"] << ": found "
@@ -559,7 +576,7 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
       expected = it2->second;
     else
       in_truth = false;
-    if (in_truth) scores.push_back(score(name, expected, r, x_t, k, seq_truth));
+    if (in_truth) scores.push_back(score(name, expected, r, ob, x_t, k, seq_truth));
     if (!expected.empty()) {
       ++truth_n;
       agree += expected == r.turn;

@@ -496,7 +496,9 @@ Json num(double v) {
 Json summarise(const std::vector<FrameScore>& frames) {
   int scored = 0, agree = 0, found = 0, absent_frames = 0, false_reports = 0, unscored = 0,
       unscored_reports = 0;
-  std::vector<double> bearing, ms;
+  std::vector<double> bearing, ms, tracked_ms;
+  // Per stage of the full passes: total, objectness, features, match, recognise, fovea.
+  std::vector<double> stage[6];
   std::map<std::string, std::map<std::string, int>> confusion;
   struct Bin {
     int n = 0, found = 0, agree = 0;
@@ -504,6 +506,13 @@ Json summarise(const std::vector<FrameScore>& frames) {
   std::vector<Bin> yb(kYawBins.size() - 1), wb(kWidthBins.size() - 1);
   for (const auto& f : frames) {
     ms.push_back(f.ms);
+    if (f.full_pass) {
+      const double v[6] = {f.ms,       f.objectness_ms, f.features_ms,
+                           f.match_ms, f.recognise_ms,  f.fovea_ms};
+      for (int i = 0; i < 6; ++i) stage[i].push_back(v[i]);
+    } else {
+      tracked_ms.push_back(f.ms);
+    }
     if (f.expected.empty()) {
       ++unscored;
       unscored_reports += f.found;
@@ -536,6 +545,16 @@ Json summarise(const std::vector<FrameScore>& frames) {
                        {"missed", static_cast<long>(ms.size()) - met},
                        {"met_rate", rate(static_cast<int>(met), static_cast<int>(ms.size()))}});
   }
+  // Where a full pass's time goes (issue 27's budget is for a full pass), and what the frames
+  // the tracker served alone cost beside it. Match includes recognise (the recognition of the
+  // ranked windows) and fovea (the second looks).
+  Json full_pass = {{"frames", stage[0].size()},
+                    {"tracked_frames", tracked_ms.size()},
+                    {"tracked_ms_median", num(quantile(tracked_ms, 0.5))}};
+  const char* names[6] = {"total", "objectness", "features", "match", "recognise", "fovea"};
+  for (int i = 0; i < 6; ++i)
+    full_pass[names[i]] = {{"median", num(quantile(stage[i], 0.5))},
+                           {"p95", num(quantile(stage[i], 0.95))}};
   auto bins = [&](const std::vector<double>& edges, const std::vector<Bin>& b) {
     Json a = Json::array();
     for (size_t i = 0; i < b.size(); ++i)
@@ -565,6 +584,7 @@ Json summarise(const std::vector<FrameScore>& frames) {
           {"ms_per_frame_mean",
            num(ms.empty() ? NAN : std::accumulate(ms.begin(), ms.end(), 0.0) / ms.size())},
           {"frame_budget", budgets},
+          {"full_pass_ms", full_pass},
           {"confusion", confusion},
           {"by_yaw_deg", bins(kYawBins, yb)},
           {"by_width_px", bins(kWidthBins, wb)}};

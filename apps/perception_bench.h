@@ -126,6 +126,10 @@ struct FrameScore {
   bool found = false;    // the target class was reported
   double u_found = NAN;  // reported object centre column [px]
   double ms = 0;
+  // The full pass's stages [ms, wall] (nav::PerceptionTiming); full_pass false: the frame was
+  // served by the tracker alone and the stages are 0.
+  bool full_pass = false;
+  double objectness_ms = 0, features_ms = 0, match_ms = 0, recognise_ms = 0, fovea_ms = 0;
   bool has_truth_json = false;
   FrameTruth truth;
   bool absent_sequence = false;
@@ -138,7 +142,8 @@ extern const std::vector<double> kWidthBins;  // edges 60,100,150,300
 /// The report over any set of frames: agreement on scored frames, found rate (overall and per
 /// bin, on scored frames), false reports (target reported on frames of target-absent
 /// sequences, or on '-' frames without a sidecar), bearing error |u_found - u| [px] on scored
-/// frames where the target was found, time per frame.
+/// frames where the target was found, time per frame, and (`full_pass_ms`) the full passes'
+/// time with the median and p95 of each stage (the tracked frames' time beside it).
 Json summarise(const std::vector<FrameScore>& frames);
 
 /// PNG: found rate and agreement against yaw and against width (two panels side by side).

@@ -175,6 +175,10 @@ TEST(BenchmarkSummary, CountsAgreementFoundRateBinsAndFalseReports) {
   FrameScore out;  // a '-' frame of a present sequence (target out of view): not a false report
   out.has_truth_json = true, out.got = "None", out.ms = 100;
   v.push_back(out);
+  // Two full passes with their stages; the other four frames the tracker served.
+  v[0].full_pass = true, v[0].objectness_ms = 30, v[0].features_ms = 20, v[0].match_ms = 50;
+  v[0].recognise_ms = 40;
+  v[4].full_pass = true, v[4].objectness_ms = 60, v[4].features_ms = 40, v[4].match_ms = 200;
   const Json s = summarise(v);
   EXPECT_EQ(s["scored_frames"], 4);
   EXPECT_DOUBLE_EQ(s["agreement"].get<double>(), 0.5);
@@ -196,6 +200,16 @@ TEST(BenchmarkSummary, CountsAgreementFoundRateBinsAndFalseReports) {
   EXPECT_EQ(fb[2]["met"], 5);
   EXPECT_EQ(fb[2]["missed"], 1);
   EXPECT_NEAR(fb[2]["met_rate"].get<double>(), 5.0 / 6, 1e-12);
+  const auto& fp = s["full_pass_ms"];
+  EXPECT_EQ(fp["frames"], 2);
+  EXPECT_EQ(fp["tracked_frames"], 4);
+  EXPECT_DOUBLE_EQ(fp["tracked_ms_median"].get<double>(), 100.0);
+  EXPECT_DOUBLE_EQ(fp["total"]["median"].get<double>(), 100.0);  // nearest rank of 100, 300
+  EXPECT_DOUBLE_EQ(fp["total"]["p95"].get<double>(), 300.0);
+  EXPECT_DOUBLE_EQ(fp["objectness"]["median"].get<double>(), 30.0);
+  EXPECT_DOUBLE_EQ(fp["match"]["p95"].get<double>(), 200.0);
+  EXPECT_DOUBLE_EQ(fp["recognise"]["p95"].get<double>(), 40.0);
+  EXPECT_DOUBLE_EQ(fp["fovea"]["median"].get<double>(), 0.0);
   const auto& yb = s["by_yaw_deg"];
   ASSERT_EQ(yb.size(), 4u);
   EXPECT_EQ(yb[0]["frames"], 1);
