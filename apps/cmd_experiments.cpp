@@ -149,7 +149,8 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
   g.config.requireAllUsedExcept(run::driverSettingPrefixes());
 
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model = run::ensureModel(args.get("model"), true);
+  const std::string model =
+      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train);
   const std::string config_file = run::writeBatchConfig(g.config, out);
 
   std::vector<run::ScenarioSpec> specs;

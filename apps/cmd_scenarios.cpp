@@ -264,7 +264,8 @@ int runScenariosCmd(const std::vector<std::string>& argv, GlobalOptions& g) {
   }
 
   // --- benchmark -----------------------------------------------------------------------------
-  const std::string model = run::ensureModel(args.get("model"), true);
+  const std::string model =
+      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train);
   std::string config_file;
   if (!g.config.keys().empty()) {
     config_file = out + "/config.json";

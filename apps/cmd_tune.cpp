@@ -235,7 +235,8 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
                        closestKey(param, known) + "'?)");
   }
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model = run::ensureModel(args.get("model"), true);
+  const std::string model =
+      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train);
   const std::string config_file = run::writeBatchConfig(g.config, out);
   std::vector<run::ScenarioSpec> specs;
   std::vector<size_t> value_of;

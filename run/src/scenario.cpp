@@ -33,19 +33,19 @@ std::string selfExecutable() {
   return p.string();
 }
 
-std::string ensureModel(const std::string& model, bool progress) {
+std::string ensureModel(const std::string& model, bool progress,
+                        const landmarks::ModelParams& train) {
   if (!model.empty()) {
     if (!fs::exists(model)) throw InputError("--model " + model + ": no such file");
     return model;
   }
   const std::string dir = resourcePath("landmarks");
   const std::string path = modelCachePath(dir, "");
-  if (!fs::exists(path)) {
-    if (progress)
-      std::cerr << "training the landmark model from " << dir << " (cached in " << path << ")\n";
-    landmarks::ModelParams mp;
-    landmarks::loadOrTrainModel(dir, path, mp, {});
-  }
+  // Also when the file exists: a cache trained with other landmarks.train settings (another
+  // version's defaults, or --set) is retrained, as `run` does, instead of being used silently.
+  if (progress && !fs::exists(path))
+    std::cerr << "training the landmark model from " << dir << " (cached in " << path << ")\n";
+  landmarks::loadOrTrainModel(dir, path, train, {});
   return path;
 }
 

@@ -12,6 +12,7 @@
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/hw/types.h"
+#include "sketchnav/landmarks/model.h"
 
 namespace sketchnav::run {
 
@@ -48,8 +49,11 @@ struct ScenarioResult {
 std::string selfExecutable();
 
 /// The landmark model to use: `model` if given, else the demo set's cached model, trained now
-/// (once, before any child starts, so children never race to train it).
-std::string ensureModel(const std::string& model, bool progress);
+/// with `train` (the run's landmarks.train.* settings) when the cache is missing or was trained
+/// from another set or with other settings (once, before any child starts, so children never
+/// race to train it).
+std::string ensureModel(const std::string& model, bool progress,
+                        const landmarks::ModelParams& train = {});
 
 /// Runs the specs with up to `jobs` children at once; results in spec order. Progress lines
 /// on stderr when `progress`.
