@@ -268,6 +268,7 @@ int runNav(const std::vector<std::string>& argv0, GlobalOptions& g) {
     auto runGoal = [&](const ros::RouteGoal& goal) -> Json {
       if (goal.sketch.empty()) throw InputError("the goal names no sketch file");
       ros::resetFault();  // a new goal after a safety stop may move the robot again
+      ros::release();     // ... or after a cancelled or preempted one
       RouteView view;
       view.out = &outputs;
       view.server = server.get();

@@ -342,7 +342,9 @@ class RosBase final : public hw::Base {
   }
 
   void command(double v, double w) override {
-    if (state().tripped || !std::isfinite(v) || !std::isfinite(w)) {
+    std::unique_lock<std::mutex> lock(state().command_m);
+    if (state().tripped || state().held || !std::isfinite(v) || !std::isfinite(w)) {
+      lock.unlock();
       stop();
       return;
     }
@@ -350,6 +352,7 @@ class RosBase final : public hw::Base {
     t.linear.x = v;
     t.angular.z = w;
     pub_.publish(t);
+    lock.unlock();
     state().last_v = v;
     state().last_w = w;
     closeLatency();

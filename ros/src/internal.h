@@ -63,6 +63,10 @@ struct State {
   RosParams params;
   std::string fault;
   std::atomic<bool> tripped{false};
+  // hold(): commands are zero until release(). command_m orders a hold against a command being
+  // published, so no command of the route can follow the hold's zero.
+  std::atomic<bool> held{false};
+  std::mutex command_m;
   std::thread watchdog, liveness;
   std::atomic<bool> watchdog_stop{false};
   std::mutex latency_mutex;

@@ -510,6 +510,22 @@ void trip(const std::string& reason) {
   log::error("ros", "safety stop: " + reason + " (zero cmd_vel sent; the robot stays stopped)");
 }
 
+void hold(const std::string& why) {
+  State& s = state();
+  {
+    std::lock_guard<std::mutex> l(s.command_m);
+    if (s.held.exchange(true)) return;
+    detail::publishZero();
+  }
+  log::info("ros", why + ": zero cmd_vel sent; the robot stays stopped until the next goal");
+}
+
+void release() {
+  State& s = state();
+  std::lock_guard<std::mutex> l(s.command_m);
+  s.held = false;
+}
+
 void resetFault() {
   State& s = state();
   std::lock_guard<std::mutex> l(s.mutex);

@@ -225,9 +225,8 @@ void NavOutputs::route(const std::vector<std::pair<double, double>>& pts, double
     p.pose.position.y = pts[i].second;
     const size_t j = i + 1 < pts.size() ? i + 1 : i;
     const size_t k = j == i && i > 0 ? i - 1 : i;
-    const double heading = j != k ? std::atan2(pts[j].second - pts[k].second,
-                                               pts[j].first - pts[k].first)
-                                  : 0.0;
+    const double heading =
+        j != k ? std::atan2(pts[j].second - pts[k].second, pts[j].first - pts[k].first) : 0.0;
     p.pose.orientation = yawQuat(heading);
     path.poses.push_back(p);
   }

@@ -51,7 +51,10 @@ struct RouteServer::Impl {
       return;
     }
     std::lock_guard<std::mutex> l(this->m);
-    if (active) cancel = true;  // preempts the running route, as an action goal does
+    if (active) {  // preempts the running route, as an action goal does
+      cancel = true;
+      hold("~start: a new route preempts the running one");
+    }
     topic_goals.push_back(g);
     cv.notify_all();
   }
@@ -60,18 +63,24 @@ struct RouteServer::Impl {
     topic_goals.clear();
     if (active) {
       cancel = true;
-      log::info("ros", "~cancel: the route is stopped");
+      hold("~cancel: the route is stopped");
     }
   }
   void onGoal() {  // actionlib: a new goal arrived (the server's lock is held)
     std::lock_guard<std::mutex> l(m);
     action_goal_waiting = true;
-    if (active) cancel = true;
+    if (active) {
+      cancel = true;
+      hold("a new action goal preempts the running route");
+    }
     cv.notify_all();
   }
   void onPreempt() {  // actionlib: the active goal is cancelled (or a new one preempts it)
     std::lock_guard<std::mutex> l(m);
-    if (active && active_is_action) cancel = true;
+    if (active && active_is_action) {
+      cancel = true;
+      hold("the action goal was cancelled");
+    }
   }
 };
 
@@ -85,7 +94,8 @@ RouteServer::RouteServer(const std::string& name) : impl_(std::make_unique<Impl>
   I.start_sub = I.pnh.subscribe("start", 5, &Impl::onStart, &I);
   I.cancel_sub = I.pnh.subscribe("cancel", 5, &Impl::onCancel, &I);
   log::info("ros", "waiting for goals",
-            {{"action", I.pnh.resolveName(name)}, {"start", I.start_sub.getTopic()},
+            {{"action", I.pnh.resolveName(name)},
+             {"start", I.start_sub.getTopic()},
              {"cancel", I.cancel_sub.getTopic()}});
 }
 

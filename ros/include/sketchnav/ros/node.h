@@ -113,6 +113,13 @@ void trip(const std::string& reason);
 /// Clears a latched fault (a new goal after a safety stop): commands pass again. A cause
 /// still present (master gone, an input stale) trips it again at the next watchdog check.
 void resetFault();
+/// Holds the robot stopped for a cancelled or preempted goal: a zero Twist now, from the
+/// caller's thread (a route server callback), whatever the control loop is doing — a
+/// perception pass can take a second on a slow machine, and the loop reads the cancel only
+/// between ticks — and every later command of the route zero. Not a fault: fault() and the
+/// diagnostics stay as they are. release() (a new goal) ends it.
+void hold(const std::string& why);
+void release();
 
 /// The ROS clock (simulated when /use_sim_time is set): now() = ros::Time::now();
 /// sleepUntil() returns early once the watchdog has tripped, so a frozen /clock cannot hang
