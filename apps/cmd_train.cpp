@@ -20,7 +20,7 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   args.option("landmarks", "landmark set: a folder of class folders (a class = a leaf folder)")
       .option("output", "model file to write (also -o)")
       .option("vocabulary", "visual words (default: landmarks.train.vocabulary_size, 1000)")
-      .option("max-features", "SIFT keypoints per photo (default 1000)")
+      .option("max-features", "SIFT keypoints per photo (default 500)")
       .option("seed", "seed for sampling and k-means (default 1)")
       .option("exclude", "comma-separated class names to leave out (rejection experiments)")
       .flag("plain-sift", "use plain SIFT descriptors instead of RootSIFT (for comparisons)");
@@ -73,8 +73,7 @@ int runTrain(const std::vector<std::string>& argv_in, GlobalOptions& g) {
   // Per class: its photos and keypoints, and what would make it weak (the photos a user has to
   // retake are easier to find here than in recognition figures later).
   constexpr int kFewPhotos = 3;
-  // Little texture: under 125 keypoints (a quarter of max_features when that is lower).
-  const int few_keypoints = std::max(20, std::min(125, p.features.max_features / 4));
+  const int few_keypoints = std::max(20, p.features.max_features / 4);
   Json per_class = Json::object();
   int weak = 0;
   for (size_t c = 0; c < m.classes().size(); ++c) {

@@ -30,10 +30,6 @@ class MatchFixture : public ::testing::Test {
     cv::imwrite(root_ + "/class1/flat.png", test::texturedImage(320, 240, 1001));
     ModelParams p;
     p.vocabulary_size = 50;
-    // The paper's offset of a rotated copy (checkRecovered) is off the object's centre by an
-    // amount that depends on where its inliers lie, i.e. on the keypoints kept: its 15 px bound
-    // was set on the photo's 500 strongest.
-    p.features.max_features = 500;
     model_ = new LandmarkModel(trainModel(root_, p));
   }
   static void TearDownTestSuite() { delete model_; }

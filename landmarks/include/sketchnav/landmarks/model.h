@@ -19,11 +19,7 @@ namespace sketchnav::landmarks {
 
 /// Training settings ("landmarks.train.*").
 struct ModelParams {
-  // Database photos: up to 1000 keypoints each (FeatureParams' 500 is for images seen once).
-  // The database side is paid once, at training; more of a photo's weaker keypoints give a
-  // view unlike the photo more to match. Evidence: doc/perception-benchmark.md, "More
-  // keypoints per database photo".
-  FeatureParams features = databaseFeatures();
+  FeatureParams features;  // database photos
   // Camera frames / query images (computeFrameFeatures(model, image)): fewer keypoints than the
   // database photos, because SIFT and the per-keypoint searches are the per-frame cost while
   // database keypoints are paid once, at training time.
@@ -58,11 +54,6 @@ struct ModelParams {
     b("seed", seed);
   }
   void validate() const;
-  static FeatureParams databaseFeatures() {
-    FeatureParams f;
-    f.max_features = 1000;
-    return f;
-  }
   /// The feature settings for frames: `features` with the frame_* limits.
   FeatureParams frameFeatures() const {
     FeatureParams f = features;
