@@ -145,12 +145,11 @@ int runExperiments(const std::vector<std::string>& argv, GlobalOptions& g) {
   for (const auto& n : names) variants.push_back(run::makeVariant(n));  // InputError on unknown
   const run::SketchNoise noise = run::sketchNoiseFrom(g.config);
   // The trials' settings (every run setting; the trials apply them again): a typo fails here.
-  run::runSettingsFrom(g.config);
+  const run::RunSettings settings = run::runSettingsFrom(g.config);
   g.config.requireAllUsedExcept(run::driverSettingPrefixes());
 
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model =
-      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train);
+  const std::string model = run::ensureModel(args.get("model"), true, settings.train);
   const std::string config_file = run::writeBatchConfig(g.config, out);
 
   std::vector<run::ScenarioSpec> specs;

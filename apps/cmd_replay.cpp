@@ -339,8 +339,8 @@ int runEval(const Args& args, GlobalOptions& g) {
     truths.push_back(bench::readTruthCsv((d / "truth.csv").string()));
     seqs.push_back(bench::readSequenceJson((d / "sequence.json").string()));
   }
-  auto model = std::make_shared<landmarks::LandmarkModel>(landmarks::LandmarkModel::load(
-      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train)));
+  auto model = std::make_shared<landmarks::LandmarkModel>(
+      run::loadModel(args.get("model"), true, run::runSettingsFrom(g.config).train));
   const auto& cls = model->classes();
   for (size_t s = 0; s < seqs.size(); ++s)
     if (std::find(cls.begin(), cls.end(), seqs[s].target) == cls.end())
@@ -535,8 +535,8 @@ int runReplay(const std::vector<std::string>& argv, GlobalOptions& g) {
     if (fs::is_regular_file(side)) seq_truth = bench::readSequenceJson(side.string());
   }
 
-  auto model = std::make_shared<landmarks::LandmarkModel>(landmarks::LandmarkModel::load(
-      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train)));
+  auto model = std::make_shared<landmarks::LandmarkModel>(
+      run::loadModel(args.get("model"), true, run::runSettingsFrom(g.config).train));
   const auto& cls = model->classes();
   if (std::find(cls.begin(), cls.end(), target) == cls.end()) {
     std::string known;

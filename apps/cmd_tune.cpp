@@ -226,7 +226,7 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
   const run::SketchNoise noise = run::sketchNoiseFrom(g.config);
   // The runs' settings (every run setting; the runs apply them again): a typo fails here, and
   // --param must name one of them.
-  run::runSettingsFrom(g.config);
+  const run::RunSettings settings = run::runSettingsFrom(g.config);
   g.config.requireAllUsedExcept(run::driverSettingPrefixes());
   {
     const auto known = g.config.knownKeys();
@@ -235,8 +235,7 @@ int runTune(const std::vector<std::string>& argv, GlobalOptions& g) {
                        closestKey(param, known) + "'?)");
   }
   const std::string out = makeOutputDir(args.get("out"));
-  const std::string model =
-      run::ensureModel(args.get("model"), true, run::runSettingsFrom(g.config).train);
+  const std::string model = run::ensureModel(args.get("model"), true, settings.train);
   const std::string config_file = run::writeBatchConfig(g.config, out);
   std::vector<run::ScenarioSpec> specs;
   std::vector<size_t> value_of;

@@ -33,20 +33,42 @@ std::string selfExecutable() {
   return p.string();
 }
 
-std::string ensureModel(const std::string& model, bool progress,
-                        const landmarks::ModelParams& train) {
+namespace {
+// The model file to use: `model` (checked to exist), or the demo set's cache path (empty
+// `demo_dir` otherwise).
+std::string modelPath(const std::string& model, std::string& demo_dir) {
   if (!model.empty()) {
     if (!fs::exists(model)) throw InputError("--model " + model + ": no such file");
     return model;
   }
-  const std::string dir = resourcePath("landmarks");
-  const std::string path = modelCachePath(dir, "");
-  // Also when the file exists: a cache trained with other landmarks.train settings (another
-  // version's defaults, or --set) is retrained, as `run` does, instead of being used silently.
+  demo_dir = resourcePath("landmarks");
+  return modelCachePath(demo_dir, "");
+}
+
+// The demo set's cached model, loaded; trained when the cache is missing, and also when it
+// exists but was trained with other landmarks.train settings (another version's defaults, or
+// --set): retrained, as `run` does, instead of being used silently.
+landmarks::LandmarkModel demoModel(const std::string& dir, const std::string& path, bool progress,
+                                   const landmarks::ModelParams& train) {
   if (progress && !fs::exists(path))
     std::cerr << "training the landmark model from " << dir << " (cached in " << path << ")\n";
-  landmarks::loadOrTrainModel(dir, path, train, {});
+  return landmarks::loadOrTrainModel(dir, path, train, {});
+}
+}  // namespace
+
+std::string ensureModel(const std::string& model, bool progress,
+                        const landmarks::ModelParams& train) {
+  std::string dir;
+  const std::string path = modelPath(model, dir);
+  if (!dir.empty()) demoModel(dir, path, progress, train);
   return path;
+}
+
+landmarks::LandmarkModel loadModel(const std::string& model, bool progress,
+                                   const landmarks::ModelParams& train) {
+  std::string dir;
+  const std::string path = modelPath(model, dir);
+  return dir.empty() ? landmarks::LandmarkModel::load(path) : demoModel(dir, path, progress, train);
 }
 
 namespace {

@@ -54,6 +54,10 @@ std::string selfExecutable();
 /// race to train it).
 std::string ensureModel(const std::string& model, bool progress,
                         const landmarks::ModelParams& train = {});
+/// The same model, loaded: `model` if given, else the demo set's cache (trained or retrained
+/// as ensureModel() does), read once (ensureModel() followed by a load reads it twice).
+landmarks::LandmarkModel loadModel(const std::string& model, bool progress,
+                                   const landmarks::ModelParams& train = {});
 
 /// Runs the specs with up to `jobs` children at once; results in spec order. Progress lines
 /// on stderr when `progress`.
