@@ -63,8 +63,9 @@ struct State {
   RosParams params;
   std::string fault;
   std::atomic<bool> tripped{false};
-  // hold(): commands are zero until release(). command_m orders a hold against a command being
-  // published, so no command of the route can follow the hold's zero.
+  // hold(): commands are zero until release(). command_m orders a hold or a trip against a
+  // command being published, so no command of the route can follow their zero. Lock order:
+  // command_m before mutex.
   std::atomic<bool> held{false};
   std::mutex command_m;
   std::thread watchdog, liveness;

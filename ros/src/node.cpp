@@ -501,12 +501,17 @@ void sendZeroCommand() {
 void trip(const std::string& reason) {
   State& s = state();
   {
-    std::lock_guard<std::mutex> l(s.mutex);
-    if (s.tripped) return;
-    s.fault = reason;
-    s.tripped = true;
+    // command_m, as in hold(): a command that read "not tripped" is published before this zero,
+    // never after it (the watchdog's repeated zero would otherwise be the only stop for 0.1 s).
+    std::lock_guard<std::mutex> c(s.command_m);
+    {
+      std::lock_guard<std::mutex> l(s.mutex);
+      if (s.tripped) return;
+      s.fault = reason;
+      s.tripped = true;
+    }
+    detail::publishZero();
   }
-  detail::publishZero();
   log::error("ros", "safety stop: " + reason + " (zero cmd_vel sent; the robot stays stopped)");
 }
 
