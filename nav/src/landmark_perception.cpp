@@ -6,9 +6,13 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
+#include <condition_variable>
+#include <exception>
+#include <functional>
 #include <future>
 #include <limits>
 #include <map>
+#include <mutex>
 
 #include "sketchnav/core/config.h"
 #include "sketchnav/landmarks/matcher.h"
@@ -265,17 +269,17 @@ bool examineCrop(const landmarks::LandmarkModel& model, const cv::Mat& img, cons
   return false;
 }
 
-// The recognition stage: the `windows` ranked by the looked-for classes' BoW score on the
-// frame's words (objectness order among equal scores), the best recognise_windows of them
-// examined at window_side px (examineCrop).
-std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, const cv::Mat& img,
-                                       const landmarks::FrameFeatures& feats,
-                                       const std::vector<cv::Rect>& windows,
-                                       const std::vector<std::string>& classes,
-                                       const hw::Intrinsics& K, const PerceptionParams& P,
-                                       int& recognised) {
-  std::vector<Detection> out;
-  if (P.recognise_windows <= 0 || windows.empty()) return out;
+// The recognition stage's choice: the `windows` ranked by the looked-for classes' keypoint votes
+// (rank_by_votes) then their BoW score on the frame's words (objectness order among equal
+// scores), the best recognise_windows of them with a margin: the crops examineCrop() looks at
+// in rank order.
+std::vector<cv::Rect> rankedCrops(const landmarks::LandmarkModel& model, const cv::Mat& img,
+                                  const landmarks::FrameFeatures& feats,
+                                  const std::vector<cv::Rect>& windows,
+                                  const std::vector<std::string>& classes,
+                                  const PerceptionParams& P) {
+  std::vector<cv::Rect> crops;
+  if (P.recognise_windows <= 0 || windows.empty()) return crops;
   // The looked-for classes the model knows (a class it was not trained on has no votes, and
   // its id -1 is what a keypoint voting for no class holds).
   std::vector<int> ids;
@@ -300,7 +304,6 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
   std::stable_sort(ranked.begin(), ranked.end(),
                    [](const auto& a, const auto& b) { return a.first > b.first; });
   const cv::Rect frame_rect(0, 0, img.cols, img.rows);
-  std::vector<cv::Rect> crops;
   for (int i = 0; i < std::min<int>(P.recognise_windows, ranked.size()); ++i) {
     const cv::Rect& w = windows[ranked[i].second];
     // A margin round the window: objectness windows often clip the object's border.
@@ -311,26 +314,76 @@ std::vector<Detection> recogniseRanked(const landmarks::LandmarkModel& model, co
     if (crop.width < 8 || crop.height < 8) continue;
     crops.push_back(crop);
   }
-  recognised += static_cast<int>(crops.size());
-  // Each crop is examined on its own (the model is only read), so with two threads the second
-  // half runs beside the first; the detections are kept in rank order either way.
-  std::vector<Detection> found(crops.size());
-  std::vector<char> ok(crops.size(), 0);
-  const auto examine = [&](size_t from, size_t to) {
-    for (size_t i = from; i < to; ++i)
-      ok[i] = examineCrop(model, img, crops[i], P.window_side, classes, K, P, found[i]);
-  };
-  if (P.threads >= 2 && crops.size() >= 2) {
-    const size_t half = (crops.size() + 1) / 2;
-    auto other = std::async(std::launch::async, examine, half, crops.size());
-    examine(0, half);
-    other.get();
-  } else {
-    examine(0, crops.size());
+  return crops;
+}
+
+// Runs a full pass's matching work on `threads` threads: first `rank()` (which decides how many
+// crops there are; one thread runs it while the other starts on the windows), then each crop
+// (the longest items: a recognition, perhaps tilted views) before the windows still left, every
+// item on whichever thread is free. The items do not depend on each other (the model and the
+// frame's caches are only read, or filled under their own lock), so the results are the same on
+// any thread count; the caller merges them in a fixed order. The first exception stops the
+// remaining items and is rethrown here.
+void runMatchingWork(int threads, size_t n_windows, const std::function<size_t()>& rank,
+                     const std::function<void(size_t)>& examine_crop,
+                     const std::function<void(size_t)>& match_window) {
+  if (threads < 2) {
+    for (size_t i = 0; i < n_windows; ++i) match_window(i);
+    const size_t n_crops = rank();
+    for (size_t i = 0; i < n_crops; ++i) examine_crop(i);
+    return;
   }
-  for (size_t i = 0; i < crops.size(); ++i)
-    if (ok[i]) out.push_back(std::move(found[i]));
-  return out;
+  std::mutex m;
+  std::condition_variable changed;
+  bool rank_taken = false, ranked = false;
+  size_t n_crops = 0, next_crop = 0, next_window = 0;
+  std::exception_ptr failure;
+  const auto worker = [&] {
+    for (;;) {
+      enum { kNone, kRank, kCrop, kWindow } what = kNone;
+      size_t i = 0;
+      {
+        std::unique_lock<std::mutex> lock(m);
+        for (;;) {
+          if (failure) break;
+          if (!rank_taken) {
+            rank_taken = true, what = kRank;
+            break;
+          }
+          if (ranked && next_crop < n_crops) {
+            what = kCrop, i = next_crop++;
+            break;
+          }
+          if (next_window < n_windows) {
+            what = kWindow, i = next_window++;
+            break;
+          }
+          if (ranked) break;   // nothing left
+          changed.wait(lock);  // the crops are not known yet
+        }
+      }
+      if (what == kNone) return;
+      try {
+        if (what == kRank) {
+          const size_t n = rank();
+          std::lock_guard<std::mutex> lock(m);
+          n_crops = n, ranked = true;
+        } else if (what == kCrop) {
+          examine_crop(i);
+        } else {
+          match_window(i);
+        }
+      } catch (...) {
+        std::lock_guard<std::mutex> lock(m);
+        if (!failure) failure = std::current_exception();
+      }
+      if (what == kRank || failure) changed.notify_all();
+    }
+  };
+  auto other = std::async(std::launch::async, worker);
+  worker();
+  other.get();
+  if (failure) std::rethrow_exception(failure);
 }
 
 // Adds `d` to `found` unless it is the same landmark as one there (overlapping windows or the
@@ -386,30 +439,57 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
   std::vector<cv::Rect> boxes;
   for (const auto& w : windows) boxes.push_back(w.box);
   if (P.whole_frame) boxes.push_back(cv::Rect());  // empty = the whole frame
+  // The work: every window (and the whole frame) matched against each looked-for class, and the
+  // best-ranked windows recognised (rankedCrops, examineCrop); spread over the threads, merged
+  // below in this order whatever ran first.
+  std::vector<std::pair<std::string, cv::Rect>> pairs;
   for (const auto& cls : classes) {
     if (model.classId(cls) < 0) continue;  // not in the model: nothing to look for
+    for (const auto& box : boxes) pairs.emplace_back(cls, box);
+  }
+  std::vector<Detection> window_found(pairs.size());
+  std::vector<char> window_ok(pairs.size(), 0);
+  const auto matchWindow = [&](size_t i) {
+    const auto& [cls, box] = pairs[i];
+    const auto m = landmarks::match(model, feats, box, cls, mp);
+    if (!m.matched) return;
+    const cv::Rect window =
+        box.area() > 0 ? box : cv::Rect(0, 0, frame.image.cols, frame.image.rows);
+    window_ok[i] = toDetection(m, cls, window, frame.image.cols, K, P, window_found[i]);
+  };
+  std::vector<cv::Rect> crops;
+  std::vector<Detection> crop_found;
+  std::vector<char> crop_ok;
+  std::vector<double> recognise_ms;  // per item, summed below
+  const auto rank = [&] {
+    const auto tr = clk::now();
+    std::vector<cv::Rect> window_boxes;
+    for (const auto& w : windows) window_boxes.push_back(w.box);
+    crops = rankedCrops(model, frame.image, feats, window_boxes, classes, P);
+    crop_found.resize(crops.size());
+    crop_ok.assign(crops.size(), 0);
+    recognise_ms.assign(crops.size() + 1, 0.0);
+    recognise_ms.back() = msSince(tr);
+    return crops.size();
+  };
+  const auto examine = [&](size_t i) {
+    const auto tr = clk::now();
+    crop_ok[i] =
+        examineCrop(model, frame.image, crops[i], P.window_side, classes, K, P, crop_found[i]);
+    recognise_ms[i] = msSince(tr);
+  };
+  runMatchingWork(P.threads, pairs.size(), rank, examine, matchWindow);
+  for (size_t c = 0; c < pairs.size(); c += boxes.size()) {
+    // The same landmark seen through overlapping windows is one detection (most inliers).
     std::vector<Detection> found;
-    for (const auto& box : boxes) {
-      const auto m = landmarks::match(model, feats, box, cls, mp);
-      if (!m.matched) continue;
-      Detection d;
-      const cv::Rect window =
-          box.area() > 0 ? box : cv::Rect(0, 0, frame.image.cols, frame.image.rows);
-      if (!toDetection(m, cls, window, frame.image.cols, K, P, d)) continue;
-      // The same landmark seen through overlapping windows is one detection (most inliers).
-      mergeDetection(found, d, P.merge_iou);
-    }
+    for (size_t i = c; i < c + boxes.size(); ++i)
+      if (window_ok[i]) mergeDetection(found, window_found[i], P.merge_iou);
     ob.detections.insert(ob.detections.end(), found.begin(), found.end());
   }
-  {
-    const auto tr = clk::now();
-    std::vector<cv::Rect> ranked_boxes;
-    for (const auto& w : windows) ranked_boxes.push_back(w.box);
-    const auto recognised = recogniseRanked(model, frame.image, feats, ranked_boxes, classes, K, P,
-                                            ob.timing.recognised);
-    for (const auto& d : recognised) mergeDetection(ob.detections, d, P.merge_iou);
-    ob.timing.recognise_ms = msSince(tr);
-  }
+  ob.timing.recognised += static_cast<int>(crops.size());
+  for (size_t i = 0; i < crops.size(); ++i)
+    if (crop_ok[i]) mergeDetection(ob.detections, crop_found[i], P.merge_iou);
+  for (const double ms : recognise_ms) ob.timing.recognise_ms += ms;
   std::sort(ob.detections.begin(), ob.detections.end(),
             [](const Detection& a, const Detection& b) { return a.inliers > b.inliers; });
   ob.timing.match_ms = msSince(t);

@@ -53,15 +53,17 @@ struct Detection {
 
 struct PerceptionTiming {
   double objectness_ms = 0, features_ms = 0, match_ms = 0, total_ms = 0;  // wall time
-  double fovea_ms = 0;      // wall time of the foveal second looks (part of total_ms)
-  double recognise_ms = 0;  // wall time of the recognition of ranked windows (part of match_ms)
-  int recognised = 0;       // windows recognised (recognise_windows at most)
-  int windows = 0;          // objectness windows examined
-  int fovea_looks = 0;      // foveal crops examined (a hinted class missed by the normal pass)
-  bool full_pass = false;   // the full pass (objectness, features, matching) ran on this frame
-  double track_ms = 0;      // wall time of the tracker's steps (part of total_ms)
-  int tracked = 0;          // detections that come from the tracker
-  int track_steps = 0;      // tracks the tracker stepped into this frame (found or lost)
+  double fovea_ms = 0;  // wall time of the foveal second looks (part of total_ms)
+  // Time spent recognising the ranked windows (ranking them, examining each crop), summed over
+  // the threads: part of match_ms's work, run beside the window matching with two threads.
+  double recognise_ms = 0;
+  int recognised = 0;      // windows recognised (recognise_windows at most)
+  int windows = 0;         // objectness windows examined
+  int fovea_looks = 0;     // foveal crops examined (a hinted class missed by the normal pass)
+  bool full_pass = false;  // the full pass (objectness, features, matching) ran on this frame
+  double track_ms = 0;     // wall time of the tracker's steps (part of total_ms)
+  int tracked = 0;         // detections that come from the tracker
+  int track_steps = 0;     // tracks the tracker stepped into this frame (found or lost)
 };
 
 /// A class to look for, with where the executive expects it (from the sketch). Without a
@@ -180,9 +182,10 @@ struct PerceptionParams {
   // tilted detection is reported at once.
   int tilt_confirm_frames = 2;
   // Threads a full pass uses for its independent stages: the objectness windows beside the
-  // frame's features, and the ranked windows' recognition split between them. 1 = everything on
-  // the calling thread. The detections are the same for any count (only the wall time
-  // changes); evidence: doc/perception-benchmark.md "Two cores".
+  // frame's features, then the windows' matching and the ranked windows' recognition taken item
+  // by item by whichever thread is free. 1 = everything on the calling thread. The detections are
+  // the same for any count (only the wall time changes); evidence: doc/perception-benchmark.md "Two
+  // cores".
   int threads = 2;
   // The matching stage's rule ("landmarks.match.*", the same settings `recognise --match`
   // reads): Lowe's ratio, RANSAC, min_inliers for a detection (never a guess below), database
