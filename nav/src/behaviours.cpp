@@ -74,6 +74,10 @@ void RecoverParams::validate() const {
   require(stuck_m >= 0, "nav.stuck_m", "must be >= 0");
   require(recover_m > 0, "nav.recover_m", "must be > 0");
   require(recover_s > 0, "nav.recover_s", "must be > 0");
+  require(recover_back_m >= 0 && recover_back_m <= 3, "nav.recover_back_m",
+          "must be in [0, 3] m (0 = never back out; the trail keeps 3 m)");
+  require(recover_back_speed > 0 && recover_back_speed <= 0.5, "nav.recover_back_speed",
+          "must be in (0, 0.5] m/s");
 }
 
 servo::Turn turnOf(double x) {
@@ -226,6 +230,7 @@ event::RecoverStart Recovery::start(double direction, const hw::Pose2D& pose, do
                                     bool look) {
   active_ = true;
   look_ = look;
+  back_ = false;
   ++count_;
   dir_ = wrapAngle(pose.theta + direction);
   t0_ = now;
@@ -233,8 +238,39 @@ event::RecoverStart Recovery::start(double direction, const hw::Pose2D& pose, do
   return event::RecoverStart{direction * 180 / M_PI, look};
 }
 
+event::RecoverStart Recovery::startBack(const Eigen::Vector2d& to, const hw::Pose2D& pose,
+                                        double now) {
+  active_ = true;
+  look_ = false;
+  back_ = true;
+  ++count_;
+  to_ = to;
+  dir_ = std::atan2(to.y() - pose.y, to.x() - pose.x);
+  t0_ = now;
+  from_ = pose;
+  event::RecoverStart e{wrapAngle(dir_ - pose.theta) * 180 / M_PI, false};
+  e.back = true;
+  return e;
+}
+
 Recovery::Step Recovery::step(const hw::Pose2D& pose, double now, double v_capped) {
   Step out;
+  if (back_) {
+    // Reversing: the heading that points away from `to_` (recomputed, so the robot stays on
+    // the line as odometry drifts), turning on the spot first when it is far off.
+    const Eigen::Vector2d d = to_ - Eigen::Vector2d(pose.x, pose.y);
+    const double away = wrapAngle(std::atan2(d.y(), d.x()) + M_PI - pose.theta);
+    const double w = std::clamp(k_heading_ * away, -max_w_, max_w_);
+    const double v = std::abs(away) > 0.35 ? 0.0 : -p_.recover_back_speed;
+    out.command = {v, w, turnOf(w)};
+    // Over once there, out of time, or when the point is no longer behind (passed it).
+    const double behind = -(std::cos(pose.theta) * d.x() + std::sin(pose.theta) * d.y());
+    if (d.norm() <= 0.05 || behind <= 0 || now - t0_ > p_.recover_s) {
+      active_ = false;
+      out.ended = true;
+    }
+    return out;
+  }
   const double a = wrapAngle(dir_ - pose.theta);
   const double w = std::clamp(k_heading_ * a, -max_w_, max_w_);
   const double v = std::abs(a) > 0.35 || look_ ? 0.0 : v_capped;
@@ -247,6 +283,52 @@ Recovery::Step Recovery::step(const hw::Pose2D& pose, double now, double v_cappe
     out.ended = true;
   }
   return out;
+}
+
+void Trail::add(const Eigen::Vector2d& p) {
+  if (!pts_.empty() && (p - pts_.back()).norm() < spacing_m_) return;
+  pts_.push_back(p);
+  // Keep the newest keep_m of path.
+  double len = 0;
+  size_t first = pts_.size() - 1;
+  while (first > 0 && len + (pts_[first] - pts_[first - 1]).norm() <= keep_m_) {
+    len += (pts_[first] - pts_[first - 1]).norm();
+    --first;
+  }
+  if (first > 0) pts_.erase(pts_.begin(), pts_.begin() + static_cast<long>(first));
+}
+
+void Trail::backTo(const Eigen::Vector2d& p) {
+  if (pts_.empty()) return;
+  size_t best = 0;
+  for (size_t i = 1; i < pts_.size(); ++i)
+    if ((pts_[i] - p).norm() < (pts_[best] - p).norm()) best = i;
+  pts_.resize(best + 1);
+}
+
+std::optional<Eigen::Vector2d> Trail::backOut(const Eigen::Vector2d& from, double len_m,
+                                              double tolerance_m) const {
+  if (pts_.empty() || len_m <= 0) return std::nullopt;
+  // Walk back from the robot until len_m of path lies behind.
+  double len = 0;
+  Eigen::Vector2d prev = from;
+  int k = static_cast<int>(pts_.size()) - 1;
+  for (; k >= 0; --k) {
+    len += (pts_[k] - prev).norm();
+    prev = pts_[k];
+    if (len >= len_m) break;
+  }
+  if (k < 0) return std::nullopt;  // a shorter trail
+  const Eigen::Vector2d to = pts_[k];
+  const Eigen::Vector2d u = to - from;
+  const double n = u.norm();
+  if (n < 0.5 * len_m) return std::nullopt;  // the path doubles back on itself
+  for (int i = static_cast<int>(pts_.size()) - 1; i >= k; --i) {
+    const Eigen::Vector2d q = pts_[i] - from;
+    const double along = std::clamp(q.dot(u) / (n * n), 0.0, 1.0);
+    if ((q - along * u).norm() > tolerance_m) return std::nullopt;  // it bends away
+  }
+  return to;
 }
 
 void DetourParams::validate() const {

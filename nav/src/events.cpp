@@ -184,6 +184,7 @@ struct Writer {
   const char* operator()(const event::RecoverStart& e) {
     j["direction_deg"] = e.direction_deg;
     j["look"] = e.look;
+    if (e.back) j["back"] = true;  // absent when not backing: the older form of the event
     return "recover_start";
   }
   const char* operator()(const event::RecoverEnd&) { return "recover_end"; }

@@ -15,6 +15,14 @@ namespace sketchnav::nav {
 
 using nlohmann::json;
 
+namespace {
+// Backing out when wedged (Recovery::startBack): the trail must run straight back within this
+// [m] of the line (the robot reversing straight stays on the floor it came over), and the point
+// backed out to lie within this [rad] of straight behind.
+constexpr double kTrailTolerance_m = 0.1;
+constexpr double kBackOutCone_rad = M_PI / 3;
+}  // namespace
+
 void ExecutiveParams::validate() const {
   DriveParams::validate();
   LandmarkTrackerParams::validate();
@@ -186,6 +194,7 @@ struct Executive::Impl {
   ProgressChecker progress_checker;
   Recovery recovery;
   bool looked = false;  // the last stuck test started a recovery that only turns to look
+  Trail trail;          // the robot's last metres of path (backing out when wedged)
   Docking docker;
   Detour detour;         // a planned way round (or docking's path)
   bool in_lane = false;  // a walker's lane covered the robot at the last step
@@ -376,6 +385,8 @@ struct Executive::Impl {
       }
     }
     if (have_pose) pose = lodo.pose();
+    // Backing out runs back along the trail; it is cut there when the back-out ends.
+    if (have_pose && !(recovery.active() && recovery.backing())) trail.add({pose.x, pose.y});
     if (have_pose) {
       for (size_t i : fresh) {
         movers.update(pose, scans[i], grid_before);
@@ -758,6 +769,20 @@ struct Executive::Impl {
               "nav",
               look ? "stuck: turning to see a way out" : "stuck: driving clear before resuming",
               {{"direction_deg", std::to_string(static_cast<int>(*dir * 180 / M_PI))}});
+        } else if (s.exec.recover_back_m > 0) {
+          // Wedged: no way out the laser sees, and behind it is blind. The robot came over the
+          // floor behind it: back out along that, when the trail runs straight back.
+          const Eigen::Vector2d at(pose.x, pose.y);
+          if (const auto to = trail.backOut(at, s.exec.recover_back_m, kTrailTolerance_m)) {
+            const double b = wrapAngle(std::atan2(to->y() - at.y(), to->x() - at.x()) - pose.theta);
+            if (std::abs(wrapAngle(b - M_PI)) <= kBackOutCone_rad) {
+              const auto started = recovery.startBack(*to, pose, now);
+              if (avoider.active()) avoider.reset();
+              event(started);
+              log::warn("nav", "stuck with no way out in view: backing out along the trail",
+                        {{"m", std::to_string(s.exec.recover_back_m)}});
+            }
+          }
         }
       }
     }
@@ -765,8 +790,10 @@ struct Executive::Impl {
       const auto r = recovery.step(pose, now, avoider.capSpeed(scans, 0.7 * s.exec.v_cruise));
       arb.propose(Behaviour::Recover, r.command);
       if (r.ended) {
-        // After a look the way out is chosen at once, with the laser's view of it.
-        if (recovery.looking())
+        // After a look, or backing out, the way out is chosen at once: with the laser's view of
+        // it, or with the room backing made.
+        if (recovery.backing()) trail.backTo({pose.x, pose.y});
+        if (recovery.looking() || recovery.backing())
           progress_checker.expire(pose, now);
         else
           progress_checker.reset(pose, now);

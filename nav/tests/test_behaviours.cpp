@@ -544,7 +544,74 @@ TEST(BehaviourParams, ValidateNamesTheSetting) {
   names(
       RecoverParams{}, [](RecoverParams& p) { p.recover_m = 0; }, "nav.recover_m");
   names(
+      RecoverParams{}, [](RecoverParams& p) { p.recover_back_m = -1; }, "nav.recover_back_m");
+  names(
+      RecoverParams{}, [](RecoverParams& p) { p.recover_back_speed = 0; },
+      "nav.recover_back_speed");
+  names(
       DockParams{}, [](DockParams& p) { p.dock_m = -1; }, "nav.dock_m");
+}
+
+TEST(Trail, BacksOutOnlyStraightAlongTheWayItCame) {
+  Trail t;
+  EXPECT_FALSE(t.backOut({0, 0}, 0.5, 0.1).has_value()) << "no trail yet";
+  for (double x = 0; x <= 2.0001; x += 0.01) t.add({x, 0.02 * std::sin(7 * x)});
+  const auto to = t.backOut({2, 0}, 0.5, 0.1);
+  ASSERT_TRUE(to.has_value());
+  EXPECT_NEAR(to->x(), 1.5, 0.06);
+  EXPECT_LT(std::abs(to->y()), 0.03);
+  EXPECT_FALSE(t.backOut({2, 0}, 2.5, 0.1).has_value()) << "longer than the trail";
+  // Round a corner 0.3 m back: the straight line back leaves the floor the robot came over.
+  Trail corner;
+  for (double x = 0; x <= 1.0001; x += 0.01) corner.add({x, 0});
+  for (double y = 0.01; y <= 0.30001; y += 0.01) corner.add({1, y});
+  EXPECT_FALSE(corner.backOut({1, 0.3}, 0.5, 0.1).has_value());
+  EXPECT_TRUE(corner.backOut({1, 0.3}, 0.25, 0.1).has_value()) << "the straight part";
+  // Only the last keep_m (3 m) of path is kept.
+  Trail longer;
+  for (double x = 0; x <= 10.0001; x += 0.01) longer.add({x, 0});
+  EXPECT_TRUE(longer.backOut({10, 0}, 2.9, 0.1).has_value());
+  EXPECT_FALSE(longer.backOut({10, 0}, 3.2, 0.1).has_value());
+  // Backed out to 9.5: the trail ends there, so the next back-out goes further back, not
+  // forward again over the stretch just reversed.
+  longer.backTo({9.5, 0});
+  const auto again = longer.backOut({9.5, 0}, 0.5, 0.1);
+  ASSERT_TRUE(again.has_value());
+  EXPECT_NEAR(again->x(), 9.0, 0.06);
+}
+
+TEST(Recovery, BacksOutAlongTheTrailThenEnds) {
+  RecoverParams p;  // 0.1 m/s back, 8 s at most
+  Recovery r(p, 1.5, 0.8);
+  const auto ev = r.startBack({1.5, 0}, {2, 0, 0}, 10.0);
+  EXPECT_TRUE(ev.back);
+  EXPECT_FALSE(ev.look);
+  EXPECT_NEAR(std::abs(ev.direction_deg), 180, 1e-9);
+  EXPECT_TRUE(r.active());
+  EXPECT_TRUE(r.backing());
+  EXPECT_TRUE((NavEvent{10.0, ev}.toJson().value("back", false)));
+  // Facing away from the point behind: reverse slowly, no turn.
+  auto s = r.step({2, 0, 0}, 10.1, 0.3);
+  EXPECT_DOUBLE_EQ(s.command.v, -p.recover_back_speed);
+  EXPECT_NEAR(s.command.w, 0.0, 1e-9);
+  EXPECT_FALSE(s.ended);
+  // Drifted off the line: steers back onto it while reversing (the point to the robot's
+  // right-behind: turn so the back points at it).
+  s = r.step({1.8, 0.05, 0}, 12.0, 0.3);
+  EXPECT_LT(s.command.v, 0.0);
+  EXPECT_GT(s.command.w, 0.0);
+  // Turned far away from it: turn on the spot first.
+  s = r.step({1.8, 0, 1.2}, 12.5, 0.3);
+  EXPECT_DOUBLE_EQ(s.command.v, 0.0);
+  EXPECT_FALSE(s.ended);
+  // There: over, and a forward recovery afterwards is not a back-out.
+  s = r.step({1.53, 0, 0}, 14.0, 0.3);
+  EXPECT_TRUE(s.ended);
+  EXPECT_FALSE(r.active());
+  r.startBack({1.5, 0}, {2, 0, 0}, 20.0);
+  EXPECT_TRUE(r.step({1.9, 0, 0}, 28.5, 0.3).ended) << "out of time (recover_s)";
+  EXPECT_FALSE(r.start(0.5, {0, 0, 0}, 30.0).back);
+  EXPECT_FALSE(r.backing());
 }
 
 }  // namespace

@@ -5,6 +5,8 @@
 // Params (keys directly under "nav.": ExecutiveParams derives from them) and reports what it did as
 // an outcome — the command it proposes (CommandArbiter decides), the event to report — and never
 // touches the devices, the run's status or the route.
+#include <Eigen/Core>
+
 #include <functional>
 #include <map>
 #include <optional>
@@ -243,6 +245,12 @@ struct RecoverParams {
   // person waiting at the robot's back is what makes them walk on into it (doc/navigation.md
   // "Evidence for the defaults").
   bool recover_look = false;
+  // With no direction known free at all (wedged: the laser sees no way forward or to the sides
+  // and nothing behind), back out this far [m] along the robot's own trail (the floor its body
+  // just crossed, Trail below), straight back, at recover_back_speed [m/s]; then choose again
+  // with room to turn. 0 = never back out (the robot stands until the run ends).
+  double recover_back_m = 0.5;
+  double recover_back_speed = 0.1;  // [m/s] slow: the laser does not see behind the robot
   template <class B>
   void bind(B& b) {
     b("stuck_s", stuck_s);
@@ -250,6 +258,8 @@ struct RecoverParams {
     b("recover_m", recover_m);
     b("recover_s", recover_s);
     b("recover_look", recover_look);
+    b("recover_back_m", recover_back_m);
+    b("recover_back_speed", recover_back_speed);
   }
   void validate() const;  // InputError "nav.<field> = ...: ..."
 };
@@ -319,6 +329,12 @@ class Recovery {
   /// choose again with the laser's view of it.
   event::RecoverStart start(double direction, const hw::Pose2D& pose, double now,
                             bool look = false);
+  /// Starts backing out from `pose` to `to` (odometry frame; a point of the robot's trail,
+  /// Trail::backOut) at recover_back_speed, keeping the heading that points away from it; over
+  /// when there (within 5 cm), after recover_s, or when the point is no longer behind.
+  event::RecoverStart startBack(const Eigen::Vector2d& to, const hw::Pose2D& pose, double now);
+  /// Whether the recovery under way (or the last one) backs out.
+  bool backing() const { return back_; }
   /// Whether the recovery under way (or the last one) only turns to look.
   bool looking() const { return look_; }
   bool active() const { return active_; }
@@ -339,9 +355,36 @@ class Recovery {
   double k_heading_, max_w_;
   bool active_ = false;
   bool look_ = false;
+  bool back_ = false;
   int count_ = 0;
   double dir_ = 0, t0_ = 0;  // escape heading (odometry frame), start time
   hw::Pose2D from_;
+  Eigen::Vector2d to_ = Eigen::Vector2d::Zero();  // backing out: where to (odometry frame)
+};
+
+/// The robot's own recent path: odometry positions at least spacing_m apart, the last keep_m
+/// [m] of it. The floor the robot's body has just crossed held nothing that stands still, and
+/// it is where the laser, blind behind the robot, cannot look: backing out along it is the way
+/// out of a spot with no way forward (Recovery::startBack).
+class Trail {
+ public:
+  explicit Trail(double keep_m = 3.0, double spacing_m = 0.05)
+      : keep_m_(keep_m), spacing_m_(spacing_m) {}
+  /// The robot is at `p` [m, odometry frame].
+  void add(const Eigen::Vector2d& p);
+  void clear() { pts_.clear(); }
+  /// The robot backed out to `p`: the trail after the point nearest to it is dropped.
+  void backTo(const Eigen::Vector2d& p);
+  /// The trail point `len_m` [m] back along the path from the robot at `from`, when every
+  /// trail point up to it lies within `tolerance_m` [m] of the straight line from `from` to it
+  /// (the robot backing straight there stays on the floor it came over). None when the trail
+  /// is shorter than `len_m` or bends away.
+  std::optional<Eigen::Vector2d> backOut(const Eigen::Vector2d& from, double len_m,
+                                         double tolerance_m) const;
+
+ private:
+  double keep_m_, spacing_m_;
+  std::vector<Eigen::Vector2d> pts_;  // oldest first
 };
 
 /// Detours (local_planner.h): while the avoider dodges something that is not coming towards

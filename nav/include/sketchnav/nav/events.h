@@ -156,6 +156,8 @@ struct RecoverStart {
   // Only turning to face the direction: its floor is out of the laser's view (the blind back
   // sector), to be seen before it is driven over.
   bool look = false;
+  // Backing out along the robot's trail (Recovery::startBack; direction_deg: where to, ~180).
+  bool back = false;
 };
 struct RecoverEnd {};
 struct GoalSettled {
