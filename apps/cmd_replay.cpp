@@ -256,17 +256,12 @@ std::string dataDir(const Args& args) {
 }
 
 /// The landmark model of --model (the demo set's, trained on first use when none is given), its
-/// search indexes built before the first frame: otherwise the first full pass pays seconds of
-/// kd-tree building, and the per-frame times and their mean report that as perception.
+/// search indexes built before the first frame (run::buildIndexes): the per-frame times and
+/// their mean are perception's, not the index build's.
 std::shared_ptr<landmarks::LandmarkModel> replayModel(const Args& args, GlobalOptions& g) {
   auto model = std::make_shared<landmarks::LandmarkModel>(
       run::loadModel(args.get("model"), true, run::runSettingsFrom(g.config).train));
-  const auto t0 = std::chrono::steady_clock::now();
-  model->buildIndexes();
-  log::info("replay", "landmark model's search indexes built",
-            {{"ms", std::to_string(std::chrono::duration<double, std::milli>(
-                                       std::chrono::steady_clock::now() - t0)
-                                       .count())}});
+  run::buildIndexes(*model, "replay");
   return model;
 }
 

@@ -37,6 +37,7 @@
 #include "sketchnav/nav/sections.h"
 #include "sketchnav/run/judge.h"
 #include "sketchnav/run/run_folder.h"
+#include "sketchnav/run/scenario.h"
 #include "sketchnav/run/summary.h"
 #include "sketchnav/sim/map_render.h"
 #include "sketchnav/sim/register.h"
@@ -489,18 +490,9 @@ Json runNavigation(const RunOptions& o) {
                  {"hash_distance_bits", std::to_string(t.distance)}});
   }
 
-  // The model's search indexes (kd-trees over every database descriptor and per class) are built
-  // now, before the route starts, rather than by the first perception pass: seconds during
-  // which that first frame's command waits (a robot standing at the start, a paced simulation
-  // falling behind the wall clock, the latency figures' maximum).
-  {
-    const auto t0 = std::chrono::steady_clock::now();
-    model->buildIndexes();
-    log::info("run", "landmark model's search indexes built",
-              {{"ms", std::to_string(std::chrono::duration<double, std::milli>(
-                                         std::chrono::steady_clock::now() - t0)
-                                         .count())}});
-  }
+  // The model's search indexes are built now, before the route starts, rather than by the first
+  // perception pass.
+  buildIndexes(*model, "run");
 
   // --- settings -----------------------------------------------------------------------------
   nav::NavSettings& settings = rs.nav;

@@ -17,6 +17,7 @@
 #include <thread>
 
 #include "sketchnav/core/error.h"
+#include "sketchnav/core/log.h"
 #include "sketchnav/core/paths.h"
 #include "sketchnav/landmarks/model.h"
 #include "sketchnav/run/run.h"
@@ -69,6 +70,15 @@ landmarks::LandmarkModel loadModel(const std::string& model, bool progress,
   std::string dir;
   const std::string path = modelPath(model, dir);
   return dir.empty() ? landmarks::LandmarkModel::load(path) : demoModel(dir, path, progress, train);
+}
+
+void buildIndexes(const landmarks::LandmarkModel& model, const char* component) {
+  const auto t0 = std::chrono::steady_clock::now();
+  model.buildIndexes();
+  log::info(component, "landmark model's search indexes built",
+            {{"ms", std::to_string(std::chrono::duration<double, std::milli>(
+                                       std::chrono::steady_clock::now() - t0)
+                                       .count())}});
 }
 
 namespace {

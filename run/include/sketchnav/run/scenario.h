@@ -58,6 +58,11 @@ std::string ensureModel(const std::string& model, bool progress,
 /// as ensureModel() does), read once (ensureModel() followed by a load reads it twice).
 landmarks::LandmarkModel loadModel(const std::string& model, bool progress,
                                    const landmarks::ModelParams& train = {});
+/// Builds `model`'s search indexes (kd-trees over every database descriptor and per class) now
+/// and logs how long it took, under `component`: done before the first frame, so that frame's
+/// perception does not pay seconds for them (a robot standing at the start, a paced simulation
+/// falling behind, the latency and per-frame figures' maximum and mean).
+void buildIndexes(const landmarks::LandmarkModel& model, const char* component);
 
 /// Runs the specs with up to `jobs` children at once; results in spec order. Progress lines
 /// on stderr when `progress`.
