@@ -20,6 +20,8 @@ import argparse
 import json
 import os
 import sys
+import threading
+import time
 
 
 def _add_message_path():
@@ -81,7 +83,31 @@ def main():
         return 2
     rospy.init_node("sketchnav_route", anonymous=True, disable_signals=True)
     client = actionlib.SimpleActionClient(args.server, NavigateSketchAction)
-    if not client.wait_for_server(rospy.Duration(args.connect_timeout)):
+
+    # The waits below are in wall seconds, as the options say. actionlib's own timeouts are in
+    # ROS time, which under /use_sim_time is the simulator's: a lock-step simulator with an idle
+    # robot runs it many times faster than the wall clock (30 "seconds" to connect passed in
+    # half a second), and one that has not started yet holds it still (a wait that never ends).
+    def wait_for_server_wall(seconds):
+        connected = []
+        t = threading.Thread(target=lambda: connected.append(client.wait_for_server()),
+                             daemon=True)
+        t.start()
+        t.join(seconds)
+        return bool(connected and connected[0])
+
+    def wait_for_result_wall(seconds):
+        deadline = time.monotonic() + seconds
+        while not rospy.is_shutdown():
+            if client.simple_state == actionlib.SimpleGoalState.DONE:
+                return True
+            if time.monotonic() >= deadline:
+                return False
+            time.sleep(0.02)
+        return client.simple_state == actionlib.SimpleGoalState.DONE
+
+    if not wait_for_server_wall(args.connect_timeout):
+        rospy.signal_shutdown("no action server")  # ends the waiting thread too
         sys.stderr.write("sketchnav_route: no action server %s answered within %.0f s (is "
                          "`sketchnav ros nav` running under ROS_MASTER_URI=%s?)\n" %
                          (args.server, args.connect_timeout, os.environ.get("ROS_MASTER_URI", "")))
@@ -102,15 +128,15 @@ def main():
     client.send_goal(goal, feedback_cb=on_feedback)
     cancelled_by_us = False
     if args.cancel_after > 0:
-        finished = client.wait_for_result(rospy.Duration(args.cancel_after))
+        finished = wait_for_result_wall(args.cancel_after)
         if not finished:
             client.cancel_goal()
             cancelled_by_us = True
-    finished = client.wait_for_result(rospy.Duration(args.timeout))
+    finished = wait_for_result_wall(args.timeout)
     if not finished:
         client.cancel_goal()
         # The server answers a cancel with a result; give it a moment so the robot is stopped.
-        client.wait_for_result(rospy.Duration(5.0))
+        wait_for_result_wall(5.0)
     state = client.get_state()
     names = {0: "PENDING", 1: "ACTIVE", 2: "PREEMPTED", 3: "SUCCEEDED", 4: "ABORTED",
              5: "REJECTED", 6: "PREEMPTING", 7: "RECALLING", 8: "RECALLED", 9: "LOST"}
