@@ -245,10 +245,9 @@ event::RecoverStart Recovery::startBack(const Eigen::Vector2d& to, const hw::Pos
   back_ = true;
   ++count_;
   to_ = to;
-  dir_ = std::atan2(to.y() - pose.y, to.x() - pose.x);
   t0_ = now;
-  from_ = pose;
-  event::RecoverStart e{wrapAngle(dir_ - pose.theta) * 180 / M_PI, false};
+  const double bearing = std::atan2(to.y() - pose.y, to.x() - pose.x) - pose.theta;
+  event::RecoverStart e{wrapAngle(bearing) * 180 / M_PI, false};
   e.back = true;
   return e;
 }

@@ -436,8 +436,7 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
 
   t = clk::now();
   const landmarks::MatchParams& mp = P.match;
-  std::vector<cv::Rect> boxes;
-  for (const auto& w : windows) boxes.push_back(w.box);
+  std::vector<cv::Rect> boxes = ob.windows;        // the objectness windows' boxes
   if (P.whole_frame) boxes.push_back(cv::Rect());  // empty = the whole frame
   // The work: every window (and the whole frame) matched against each looked-for class, and the
   // best-ranked windows recognised (rankedCrops, examineCrop); spread over the threads, merged
@@ -463,9 +462,7 @@ Observation LandmarkPerception::fullPass(const hw::Frame& frame, const hw::Intri
   std::vector<double> recognise_ms;  // per item, summed below
   const auto rank = [&] {
     const auto tr = clk::now();
-    std::vector<cv::Rect> window_boxes;
-    for (const auto& w : windows) window_boxes.push_back(w.box);
-    crops = rankedCrops(model, frame.image, feats, window_boxes, classes, P);
+    crops = rankedCrops(model, frame.image, feats, ob.windows, classes, P);
     crop_found.resize(crops.size());
     crop_ok.assign(crops.size(), 0);
     recognise_ms.assign(crops.size() + 1, 0.0);
